@@ -1,0 +1,285 @@
+"""The scheduling problem of SPEC §1: plain, immutable data checked at construction.
+
+Times are exact `Fraction`s: travel times such as distance * 10/3 must not be rounded
+before a solver decides how to put them on its own grid.
+"""
+
+from collections import Counter
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from fractions import Fraction
+
+
+class ProblemError(ValueError):
+    """A scenario that cannot describe a scheduling problem; `problems` lists every reason."""
+
+    def __init__(self, problems):
+        self.problems = list(problems)
+        super().__init__('\n'.join(self.problems))
+
+
+@dataclass(frozen=True)
+class Robot:
+    name: str
+    type: str
+    speed: Fraction = Fraction(1)
+    start_location: str | None = None
+    release_time: Fraction = Fraction(0)
+
+
+@dataclass(frozen=True)
+class Job:
+    name: str
+    location: str
+    plans: tuple[tuple[int, ...], ...]
+    """Each plan is a multiset of operation types, done at once by distinct robots."""
+
+
+@dataclass(frozen=True)
+class FixedJob:
+    """A job already running when the problem is posed: it keeps its plan, robots and times."""
+
+    plan: int
+    start: Fraction
+    end: Fraction
+    robots: Mapping[str, int]
+    """robot name -> operation type it performs."""
+
+
+@dataclass(frozen=True)
+class Problem:
+    operation_types: Mapping[int, str]
+    robot_types: Mapping[str, Mapping[int, Fraction]]
+    """robot type -> operation type -> time to perform it (absent: cannot)."""
+    robots: tuple[Robot, ...]
+    jobs: tuple[Job, ...]
+    distances: Mapping[tuple[str, str], Fraction] = field(default_factory=dict)
+    """Symmetric; a pair that is absent is at distance 0 only if both names are equal."""
+    precedence: tuple[tuple[str, str], ...] = ()
+    """(before, after): after starts no earlier than before completes."""
+    holding: tuple[tuple[str, str, int], ...] = ()
+    """(from, to, operation type): type-q robots of `from` do type q in `to`, directly."""
+    locomote: int | None = None
+    """Operation type whose efficiency scales travel; None means travel is free."""
+    time_overrides: Mapping[tuple[str, int], Fraction] = field(default_factory=dict)
+    """(robot, operation type) -> time, replacing the robot type's efficiency."""
+    fixed: Mapping[str, FixedJob] = field(default_factory=dict)
+    name: str = 'problem'
+
+    def __post_init__(self):
+        problems = _structural_problems(self)
+        if problems:
+            raise ProblemError(problems)
+        object.__setattr__(self, '_robot_by_name', {r.name: r for r in self.robots})
+        object.__setattr__(self, '_job_by_name', {j.name: j for j in self.jobs})
+        problems = _cycle_problems(self) + _holding_problems(self) + _staffing_problems(self)
+        if problems:
+            raise ProblemError(problems)
+
+    def robot(self, name: str) -> Robot:
+        return self._robot_by_name[name]
+
+    def job(self, name: str) -> Job:
+        return self._job_by_name[name]
+
+    def duration(self, robot: str, operation_type: int) -> Fraction | None:
+        """Time `robot` takes for one operation of the type, or None if it cannot do it."""
+        override = self.time_overrides.get((robot, operation_type))
+        if override is not None:
+            return override
+        return self.robot_types[self.robot(robot).type].get(operation_type)
+
+    def distance(self, a: str, b: str) -> Fraction:
+        if a == b:
+            return Fraction(0)
+        return self.distances[(a, b)]
+
+    def travel(self, robot: str, a: str, b: str) -> Fraction:
+        """Time for `robot` to move from location a to location b."""
+        if self.locomote is None or a == b:
+            return Fraction(0)
+        distance = self.distance(a, b)
+        if distance == 0:
+            return Fraction(0)
+        r = self.robot(robot)
+        return distance * self.robot_types[r.type][self.locomote] / r.speed
+
+    def locations(self) -> list[str]:
+        names = {j.location for j in self.jobs}
+        names.update(r.start_location for r in self.robots if r.start_location)
+        return sorted(names)
+
+    def predecessors(self, job: str) -> list[str]:
+        return [a for a, b in self.precedence if b == job]
+
+
+def _structural_problems(p: Problem) -> list[str]:
+    """Every inconsistency of ids and numbers, each naming what is wrong."""
+    problems = []
+    robot_names = [r.name for r in p.robots]
+    job_names = [j.name for j in p.jobs]
+    for kind, names in (('robot', robot_names), ('job', job_names)):
+        for name, count in Counter(names).items():
+            if count > 1:
+                problems.append(f"{kind} '{name}' is defined {count} times")
+    jobs = set(job_names)
+    robots = set(robot_names)
+    if p.locomote is not None and p.locomote not in p.operation_types:
+        problems.append(f'locomote operation type {p.locomote} is not a defined operation type')
+    for type_name, efficiency in p.robot_types.items():
+        for q, time in efficiency.items():
+            if q not in p.operation_types:
+                problems.append(f"robot type '{type_name}': unknown operation type {q}")
+            elif time < 0:
+                problems.append(f"robot type '{type_name}': negative time {time} for type {q}")
+        if p.locomote is not None and p.locomote not in efficiency:
+            problems.append(f"robot type '{type_name}' has no efficiency for the locomote "
+                            f'operation type {p.locomote}, so it cannot travel')
+    for r in p.robots:
+        if r.type not in p.robot_types:
+            problems.append(f"robot '{r.name}': unknown robot type '{r.type}'")
+        if r.speed <= 0:
+            problems.append(f"robot '{r.name}': speed must be positive, got {r.speed}")
+        if r.release_time < 0:
+            problems.append(f"robot '{r.name}': negative release time {r.release_time}")
+    for (robot, q), time in p.time_overrides.items():
+        if robot not in robots:
+            problems.append(f"time override names unknown robot '{robot}'")
+        if q not in p.operation_types:
+            problems.append(f"time override for '{robot}' names unknown operation type {q}")
+        if time < 0:
+            problems.append(f"time override for '{robot}', type {q}: negative time {time}")
+    for j in p.jobs:
+        if not j.plans:
+            problems.append(f"job '{j.name}' has no process plan")
+        for index, plan in enumerate(j.plans):
+            if not plan:
+                problems.append(f"job '{j.name}': plan {index} has no operation")
+            for q in plan:
+                if q not in p.operation_types:
+                    problems.append(f"job '{j.name}': plan {index} uses unknown operation "
+                                    f'type {q}')
+    for (a, b), d in p.distances.items():
+        if d < 0:
+            problems.append(f"distance '{a}'-'{b}' is negative ({d})")
+    if p.locomote is not None:
+        problems.extend(_missing_distances(p))
+    for a, b in p.precedence:
+        for name in (a, b):
+            if name not in jobs:
+                problems.append(f"precedence arc ('{a}', '{b}') names unknown job '{name}'")
+    for a, b, q in p.holding:
+        for name in (a, b):
+            if name not in jobs:
+                problems.append(f"holding arc ('{a}', '{b}', {q}) names unknown job '{name}'")
+        if q not in p.operation_types:
+            problems.append(f"holding arc ('{a}', '{b}', {q}): unknown operation type {q}")
+    for name, fixed in p.fixed.items():
+        if name not in jobs:
+            problems.append(f"fixed job '{name}' is not a job")
+        if fixed.end < fixed.start:
+            problems.append(f"fixed job '{name}' ends before it starts")
+        for robot in fixed.robots:
+            if robot not in robots:
+                problems.append(f"fixed job '{name}' names unknown robot '{robot}'")
+    return problems
+
+
+def _missing_distances(p: Problem) -> list[str]:
+    locations = {j.location for j in p.jobs}
+    locations.update(r.start_location for r in p.robots if r.start_location)
+    ordered = sorted(locations)
+    missing = []
+    for i, a in enumerate(ordered):
+        for b in ordered[i + 1:]:
+            if (a, b) not in p.distances or (b, a) not in p.distances:
+                missing.append(f"no distance between locations '{a}' and '{b}'")
+            elif p.distances[(a, b)] != p.distances[(b, a)]:
+                missing.append(f"distance '{a}'-'{b}' is not symmetric: "
+                               f'{p.distances[(a, b)]} vs {p.distances[(b, a)]}')
+    return missing
+
+
+def _cycle_problems(p: Problem) -> list[str]:
+    """Name one cycle of the precedence graph (holding arcs order jobs too), if any."""
+    successors = {j.name: [] for j in p.jobs}
+    for a, b in list(p.precedence) + [(a, b) for a, b, _ in p.holding]:
+        successors[a].append(b)
+    state = {}
+    for root in successors:
+        if root in state:
+            continue
+        path = [root]
+        state[root] = 'open'
+        stack = [iter(successors[root])]
+        while stack:
+            nxt = next(stack[-1], None)
+            if nxt is None:
+                state[path.pop()] = 'closed'
+                stack.pop()
+            elif state.get(nxt) == 'open':
+                cycle = path[path.index(nxt):] + [nxt]
+                return ['precedence cycle: ' + ' -> '.join(cycle)]
+            elif nxt not in state:
+                state[nxt] = 'open'
+                path.append(nxt)
+                stack.append(iter(successors[nxt]))
+    return []
+
+
+def _holding_problems(p: Problem) -> list[str]:
+    problems = []
+    seen_from, seen_to = {}, {}
+    for a, b, q in p.holding:
+        arc = f"holding arc ('{a}', '{b}', {q})"
+        if a == b:
+            problems.append(f'{arc} joins a job to itself')
+            continue
+        for name in (a, b):
+            if not any(q in plan for plan in p.job(name).plans):
+                problems.append(f"{arc} needs operation type {q} but job '{name}' "
+                                'has no such operation')
+        if (a, q) in seen_from:
+            problems.append(f"{arc}: job '{a}' already holds type {q} into "
+                            f"'{seen_from[a, q]}'; a robot cannot go directly to both")
+        if (b, q) in seen_to:
+            problems.append(f"{arc}: job '{b}' is already held with type {q} from "
+                            f"'{seen_to[b, q]}'; a robot cannot come directly from both")
+        seen_from[a, q] = b
+        seen_to[b, q] = a
+    return problems
+
+
+def _staffing_problems(p: Problem) -> list[str]:
+    """A job none of whose plans can be given distinct, able robots."""
+    problems = []
+    for job in p.jobs:
+        if job.name in p.fixed:
+            continue
+        shortfalls = []
+        for index, plan in enumerate(job.plans):
+            staffed = max_staffed(p, plan, [r.name for r in p.robots])
+            if staffed < len(plan):
+                shortfalls.append(f'plan {index} {sorted(plan)} needs {len(plan)} distinct '
+                                  f'robots able to do its operations; {staffed} can')
+        if len(shortfalls) == len(job.plans):
+            problems.append(f"job '{job.name}' cannot be staffed: " + '; '.join(shortfalls))
+    return problems
+
+
+def max_staffed(p: Problem, plan, robots) -> int:
+    """How many operations of `plan` can go to distinct robots among `robots` (a matching)."""
+    able = [[r for r in robots if p.duration(r, q) is not None] for q in plan]
+    owner = {}
+
+    def augment(op, visited):
+        for r in able[op]:
+            if r in visited:
+                continue
+            visited.add(r)
+            if r not in owner or augment(owner[r], visited):
+                owner[r] = op
+                return True
+        return False
+
+    return sum(augment(op, set()) for op in range(len(plan)))

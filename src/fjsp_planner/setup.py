@@ -1,0 +1,27 @@
+from glob import glob
+
+from setuptools import find_packages, setup
+
+package_name = 'fjsp_planner'
+
+setup(
+    name=package_name,
+    version='0.1.0',
+    packages=find_packages(exclude=['test']),
+    data_files=[
+        ('share/ament_index/resource_index/packages', ['resource/' + package_name]),
+        ('share/' + package_name, ['package.xml']),
+        ('share/' + package_name + '/scenarios', glob('../../config/scenarios/*.yaml')),
+    ],
+    install_requires=['setuptools'],
+    zip_safe=True,
+    maintainer='fjsp team',
+    maintainer_email='team@fjsp.invalid',
+    description='Multi-robot assembly task allocation: CP-SAT planner and ROS 2 nodes',
+    license='Apache-2.0',
+    entry_points={
+        'console_scripts': [
+            'fjsp-solve = fjsp_planner.cli:main',
+        ],
+    },
+)
