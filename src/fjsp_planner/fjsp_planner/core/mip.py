@@ -1,0 +1,399 @@
+"""The paper's §IV mixed integer program, solved through OR-Tools' `pywraplp` (SCIP or HiGHS).
+
+Variables (names as printed): s_j, c_j, c_max; binaries x_jp (plan p of job j), x_jm (robot m
+works on j), x_jj'm (m goes from j directly to j'), x_jpom (m does operation o of plan p),
+x^start_jm / x^end_jm (j is m's first / last job). The unused c_jpo and c_jm of the paper's
+variable list are left out: no printed constraint needs them beyond c_j >= s_j + T x_jpom.
+
+Where the printed model slips, this module implements the evident intent:
+
+1. Travel (printed `s_j >= c_j' + (S_jj'm + L) x_jj'm - L`, with x_jj'm = "m moves from j to
+   j'"): the arc must be the one *into* j, so we write
+   `s_j >= c_j' + (S_j'jm + L) x_j'jm - L`. Under SPEC §1 every robot of j' is busy until
+   c_j', so c_j' (not the robot's own operation end) is right.
+2. Per-operation assignment (printed `x_jp = Σ_m Σ_o x_jpom  ∀ j,p`, which would staff only one
+   operation of a plan): `Σ_m x_jpom = x_jp  ∀ j,p,o`.
+3. Robot on job (printed `Σ_p Σ_o x_jpom <= x_jm  ∀ j,p,m`): `=` and `∀ j,m`, so x_jm is 1
+   exactly when m does an operation of j; with x_jm binary this is also SPEC's "a robot does
+   at most one operation of a job".
+4. Path ends (printed `Σ_j x^start_jm = Σ_j x^end_jm = 1`): `<= 1`, so a robot may stay idle
+   (an FJSP machine nobody needs, a spare robot).
+5. Holding (printed over `ō` and `P_j` on both sides): ō is the arc's operation *type* q, the
+   right-hand sum runs over the plans P_j' of j', and operations are counted by type because
+   plans are multisets: `Σ_p Σ_{o: type q} x_jpom = Σ_p' Σ_{o: type q} x_j'p'om` and
+   `x_jj'm >= Σ_p Σ_{o: type q} x_jpom  ∀ m, (j, j', q) ∈ H` (no arc variable: no holder m).
+
+Extensions of SPEC §1 the paper does not print: a robot with a start location travels from it
+to its first job, and no robot starts before its release time; a fixed (already running) job
+keeps its plan, robots and times and is the first job of its robots. Arcs j -> j' with j' a
+precedence ancestor of j cannot be used and are not created.
+
+Durations are rational. Every time is scaled by the LCM of the denominators so the model has
+integer data and its bound can be rounded up to the grid. The schedule itself is rebuilt in
+exact `Fraction` arithmetic from the solver's decisions (plans, robots, robot sequences) as
+the earliest-start schedule of those decisions, so it never depends on solver tolerances.
+"""
+
+import math
+import time
+from fractions import Fraction
+
+from ortools.linear_solver import pywraplp
+
+from fjsp_planner.core.problem import Problem
+from fjsp_planner.core.schedule import JobAssignment, Result, Schedule, Status
+
+BACKENDS = ('SCIP', 'HIGHS')
+MAX_GRID = 10 ** 6
+"""Finer grids than this give badly scaled models; the times then stay unscaled floats."""
+
+
+def solve_mip(problem: Problem, time_limit: float = 10.0, backend: str = 'SCIP',
+              workers: int = 1, hint: Schedule | None = None) -> Result:
+    """Minimise the makespan of `problem` with the §IV MIP on `backend` ('SCIP' or 'HIGHS')."""
+    backend = backend.upper()
+    if backend not in BACKENDS:
+        raise ValueError(f"unknown MIP backend '{backend}'; choose one of {', '.join(BACKENDS)}")
+    solver = pywraplp.Solver.CreateSolver(backend)
+    if solver is None:
+        raise RuntimeError(f"OR-Tools was built without the '{backend}' MIP backend")
+    started = time.perf_counter()
+    model = _Model(problem, solver, hint)
+    solver.SetTimeLimit(max(1, int(time_limit * 1000)))
+    solver.SetNumThreads(max(1, workers))
+    params = pywraplp.MPSolverParameters()
+    # The default relative gap (1e-4) would let the solver call a non-optimal makespan optimal
+    # once times are scaled to a fine grid.
+    params.SetDoubleParam(pywraplp.MPSolverParameters.RELATIVE_MIP_GAP, 0.0)
+    code = solver.Solve(params)
+    seconds = time.perf_counter() - started
+    return model.result(code, seconds, f'mip-{backend.lower()}')
+
+
+def _grid(values) -> int:
+    scale = 1
+    for value in values:
+        scale = math.lcm(scale, Fraction(value).denominator)
+    return scale
+
+
+class _Model:
+    def __init__(self, problem: Problem, solver, hint):
+        self.p = problem
+        self.solver = solver
+        self.robots = [r.name for r in problem.robots]
+        self.jobs = [j.name for j in problem.jobs]
+        self._durations()
+        self._scale()
+        self._variables()
+        self._constraints()
+        if hint is not None:
+            self._hint(hint)
+        solver.Minimize(self.c_max)
+
+    # ----- data -------------------------------------------------------------------------
+    def _durations(self):
+        p = self.p
+        self.ops = {}
+        """(j, plan, o) -> (type, {robot: exact time}) for robots able to do it."""
+        for job in p.jobs:
+            for plan_index, plan in enumerate(job.plans):
+                for o, q in enumerate(plan):
+                    able = {m: p.duration(m, q) for m in self.robots}
+                    self.ops[job.name, plan_index, o] = (
+                        q, {m: t for m, t in able.items() if t is not None})
+        self.travel = {}
+        """(robot, j', j) -> exact travel time from j' to j."""
+        for m in self.robots:
+            for a in p.jobs:
+                for b in p.jobs:
+                    if a.name != b.name:
+                        self.travel[m, a.name, b.name] = p.travel(m, a.location, b.location)
+        self.ready = {}
+        """(robot, j) -> earliest start of j if it is the robot's first job."""
+        for r in p.robots:
+            for job in p.jobs:
+                leg = (p.travel(r.name, r.start_location, job.location)
+                       if r.start_location else Fraction(0))
+                self.ready[r.name, job.name] = r.release_time + leg
+
+    def _scale(self):
+        values = [t for _, times in self.ops.values() for t in times.values()]
+        values += list(self.travel.values()) + list(self.ready.values())
+        for fixed in self.p.fixed.values():
+            values += [fixed.start, fixed.end]
+        scale = _grid(values)
+        if scale > MAX_GRID:
+            self.scale = None
+            self.notes = (f'times not scaled: their common grid 1/{scale} is too fine; the '
+                          'model uses floats and the schedule is recomputed exactly',)
+        else:
+            self.scale = scale
+            self.notes = (f'times scaled by {scale} to an integer grid (unit 1/{scale}); the '
+                          'schedule is recomputed exactly from the chosen plans and sequences',)
+
+    def _num(self, value) -> float:
+        return float(value * self.scale) if self.scale else float(value)
+
+    def _horizon(self, hint) -> float:
+        """An upper bound on the optimal makespan: every earliest-start schedule is a chain of
+        distinct jobs, each adding at most its longest duration and longest trip in."""
+        p = self.p
+        longest_trip = max(self.travel.values(), default=Fraction(0))
+        total = max([Fraction(0)] + [f.end for f in p.fixed.values()])
+        total += max(self.ready.values(), default=Fraction(0))
+        for job in p.jobs:
+            if job.name in p.fixed:
+                continue
+            total += longest_trip + max(
+                max(times.values(), default=Fraction(0))
+                for (j, _, _), (_, times) in self.ops.items() if j == job.name)
+        if hint is not None:
+            total = min(total, hint.makespan)
+        return math.ceil(self._num(total))
+
+    # ----- model ------------------------------------------------------------------------
+    def _variables(self):
+        s, p = self.solver, self.p
+        self.H = self._horizon(None)
+        self.L = self.H + math.ceil(max(
+            (self._num(t) for t in self.travel.values()), default=0.0))
+        self.c_max = s.NumVar(0, self.H, 'c_max')
+        self.start = {j: s.NumVar(0, self.H, f's_{j}') for j in self.jobs}
+        self.end = {j: s.NumVar(0, self.H, f'c_{j}') for j in self.jobs}
+        self.x_plan = {(j.name, k): s.BoolVar(f'x_{j.name}_{k}')
+                       for j in p.jobs for k in range(len(j.plans))}
+        self.x_op = {(j, k, o, m): s.BoolVar(f'x_{j}_{k}_{o}_{m}')
+                     for (j, k, o), (_, times) in self.ops.items() for m in times}
+        able = {j: set() for j in self.jobs}
+        for (j, _, _, m) in self.x_op:
+            able[j].add(m)
+        self.able = able
+        self.x_on = {(j, m): s.BoolVar(f'x_{j}_{m}') for j in self.jobs for m in able[j]}
+        ancestors = self._ancestors()
+        self.x_arc = {(a, b, m): s.BoolVar(f'x_{a}_{b}_{m}')
+                      for m in self.robots for a in self.jobs for b in self.jobs
+                      if a != b and m in able[a] and m in able[b] and b not in ancestors[a]}
+        self.ops_of = {j: {} for j in self.jobs}
+        for (j, k, o, m), x in self.x_op.items():
+            self.ops_of[j][k, o, m] = x
+        self.arcs_out = {key: [] for key in self.x_on}
+        self.arcs_in = {key: [] for key in self.x_on}
+        for (a, b, m), x in self.x_arc.items():
+            self.arcs_out[a, m].append(x)
+            self.arcs_in[b, m].append(x)
+        self.x_first = {(j, m): s.BoolVar(f'xstart_{j}_{m}') for (j, m) in self.x_on}
+        self.x_last = {(j, m): s.BoolVar(f'xend_{j}_{m}') for (j, m) in self.x_on}
+
+    def _ancestors(self):
+        before = {j: set() for j in self.jobs}
+        arcs = list(self.p.precedence) + [(a, b) for a, b, _ in self.p.holding]
+        changed = True
+        while changed:
+            changed = False
+            for a, b in arcs:
+                grown = before[b] | before[a] | {a}
+                if grown != before[b]:
+                    before[b] = grown
+                    changed = True
+        return before
+
+    def _constraints(self):
+        s, p = self.solver, self.p
+        fixed = p.fixed
+        for j in self.jobs:
+            s.Add(self.c_max >= self.end[j])
+        for a, b in p.precedence:
+            s.Add(self.start[b] >= self.end[a])
+        for (a, b, m), x in self.x_arc.items():
+            if b in fixed:
+                continue  # a running job's robots are already there
+            leg = self._num(self.travel[m, a, b])
+            s.Add(self.start[b] >= self.end[a] + (leg + self.L) * x - self.L)
+        for (j, k, o, m), x in self.x_op.items():
+            if j not in fixed:
+                s.Add(self.end[j] >= self.start[j] + self._num(self.ops[j, k, o][1][m]) * x)
+        for job in p.jobs:
+            s.Add(s.Sum(self.x_plan[job.name, k] for k in range(len(job.plans))) == 1)
+        for (j, k, o), (_, times) in self.ops.items():
+            for m in times:
+                s.Add(self.x_op[j, k, o, m] <= self.x_plan[j, k])
+            s.Add(s.Sum(self.x_op[j, k, o, m] for m in times) == self.x_plan[j, k])
+        for (j, m), x in self.x_on.items():
+            s.Add(s.Sum(v for (_, _, mm), v in self.ops_of[j].items() if mm == m) == x)
+            s.Add(x == self.x_last[j, m] + s.Sum(self.arcs_out[j, m]))
+            s.Add(x == self.x_first[j, m] + s.Sum(self.arcs_in[j, m]))
+            if j not in fixed:
+                s.Add(self.start[j] >= self._num(self.ready[m, j]) * self.x_first[j, m])
+        for m in self.robots:
+            s.Add(s.Sum(self.x_first[j, m] for j in self.jobs if (j, m) in self.x_first) <= 1)
+            s.Add(s.Sum(self.x_last[j, m] for j in self.jobs if (j, m) in self.x_last) <= 1)
+        for a, b, q in p.holding:
+            for m in self.robots:
+                held = self._doing(a, q, m)
+                if not held:
+                    # m cannot do q in j: it must not do it in j' either.
+                    s.Add(s.Sum(self._doing(b, q, m)) == 0)
+                    continue
+                s.Add(s.Sum(held) == s.Sum(self._doing(b, q, m)))
+                arc = self.x_arc.get((a, b, m))
+                s.Add((arc if arc is not None else 0) >= s.Sum(held))
+        for name, job in fixed.items():
+            self._fix(name, job)
+
+    def _doing(self, j, q, m):
+        """The terms of Σ_p Σ_{o of type q} x_jpom: robot m does a type-q operation of j."""
+        return [v for (k, o, mm), v in self.ops_of[j].items()
+                if mm == m and self.ops[j, k, o][0] == q]
+
+    def _fix(self, name, fixed):
+        for k in range(len(self.p.job(name).plans)):
+            self.x_plan[name, k].SetBounds(int(k == fixed.plan), int(k == fixed.plan))
+        free_ops = {o: q for o, q in enumerate(self.p.job(name).plans[fixed.plan])}
+        chosen = {}
+        for robot, q in fixed.robots.items():
+            o = next((o for o, qq in free_ops.items() if qq == q), None)
+            if o is not None:
+                chosen[o, robot] = True
+                del free_ops[o]
+        for (j, k, o, m), x in self.x_op.items():
+            if j == name:
+                value = int(k == fixed.plan and (o, m) in chosen)
+                x.SetBounds(value, value)
+        for robot in fixed.robots:
+            if (name, robot) in self.x_first:
+                self.x_first[name, robot].SetBounds(1, 1)
+        self.start[name].SetBounds(self._num(fixed.start), self._num(fixed.start))
+        self.end[name].SetBounds(self._num(fixed.end), self._num(fixed.end))
+
+    def _hint(self, hint: Schedule):
+        """Tighten the horizon to the hint's makespan and pass its decisions as a MIP start."""
+        horizon = self._horizon(hint)
+        self.c_max.SetUb(horizon)
+        variables, values = [], []
+        for j, a in hint.jobs.items():
+            for k in range(len(self.p.job(j).plans)):
+                variables.append(self.x_plan[j, k])
+                values.append(float(k == a.plan))
+            variables += [self.start[j], self.end[j]]
+            values += [self._num(a.start), self._num(a.end)]
+        for m, sequence in hint.sequences.items():
+            for index, j in enumerate(sequence):
+                if (j, m) not in self.x_first:
+                    continue
+                variables += [self.x_first[j, m], self.x_last[j, m]]
+                values += [float(index == 0), float(index == len(sequence) - 1)]
+                if index + 1 < len(sequence) and (j, sequence[index + 1], m) in self.x_arc:
+                    variables.append(self.x_arc[j, sequence[index + 1], m])
+                    values.append(1.0)
+        self.solver.SetHint(variables, values)
+
+    # ----- answer -----------------------------------------------------------------------
+    def result(self, code, seconds, name) -> Result:
+        found = code in (pywraplp.Solver.OPTIMAL, pywraplp.Solver.FEASIBLE)
+        if code == pywraplp.Solver.INFEASIBLE:
+            return Result(Status.INFEASIBLE, None, None, seconds, None, name, notes=self.notes)
+        if not found:
+            return Result(Status.UNKNOWN, None, self._bound(), seconds, None, name,
+                          notes=self.notes)
+        schedule = self._schedule()
+        bound = self._bound()
+        if code == pywraplp.Solver.OPTIMAL:
+            bound = schedule.makespan if bound is None else max(bound, schedule.makespan)
+        bound = min(bound, schedule.makespan) if bound is not None else None
+        status = Status.OPTIMAL if bound == schedule.makespan else Status.FEASIBLE
+        return Result(status, schedule.makespan, bound, seconds, schedule, name,
+                      notes=self.notes)
+
+    def _bound(self) -> Fraction | None:
+        value = self.solver.Objective().BestBound()
+        if not math.isfinite(value):
+            return None
+        if self.scale:
+            # Every earliest-start makespan lies on the grid, so a bound rounds up to it.
+            return Fraction(max(0, math.ceil(value - 1e-6)), self.scale)
+        return max(Fraction(0), Fraction(value).limit_denominator(10 ** 6))
+
+    def _schedule(self) -> Schedule:
+        p = self.p
+        plan = {j: next(k for k in range(len(p.job(j).plans))
+                        if self.x_plan[j, k].solution_value() > 0.5) for j in self.jobs}
+        robots = {j: {} for j in self.jobs}
+        for (j, k, o, m), x in self.x_op.items():
+            if k == plan[j] and x.solution_value() > 0.5:
+                robots[j][m] = self.ops[j, k, o][0]
+        sequences = {m: self._sequence(m) for m in self.robots}
+        return earliest_schedule(p, plan, robots, sequences)
+
+    def _sequence(self, m):
+        mine = [j for (j, mm), x in self.x_on.items() if mm == m and x.solution_value() > 0.5]
+        after = {a: b for (a, b, mm), x in self.x_arc.items()
+                 if mm == m and x.solution_value() > 0.5}
+        first = [j for j in mine if self.x_first[j, m].solution_value() > 0.5]
+        path, seen = [], set()
+        j = first[0] if first else None
+        while j is not None and j not in seen:
+            path.append(j)
+            seen.add(j)
+            j = after.get(j)
+        if len(path) == len(mine):
+            return tuple(path)
+        # Only zero-length jobs can close a cycle of arcs; order by the solver's times then.
+        return tuple(sorted(mine, key=lambda j: (round(self.start[j].solution_value(), 6),
+                                                 round(self.end[j].solution_value(), 6))))
+
+
+def earliest_schedule(problem: Problem, plan, robots, sequences) -> Schedule:
+    """The earliest-start schedule, in exact time, of given plans, robots and robot sequences.
+
+    A job starts when its predecessors are complete and each of its robots has finished its
+    previous job and travelled over (or, for its first job, is released and has come from its
+    start location); it completes when its slowest operation ends. Fixed jobs keep their times.
+    """
+    p = problem
+    blockers = {j.name: set() for j in p.jobs}
+    for a, b in p.precedence:
+        blockers[b].add(a)
+    previous = {}
+    for m, sequence in sequences.items():
+        for a, b in zip(sequence, sequence[1:], strict=False):
+            blockers[b].add(a)
+            previous[m, b] = a
+    start, end = {}, {}
+    order = _topological(blockers)
+    for j in order:
+        if j in p.fixed:
+            start[j], end[j] = p.fixed[j].start, p.fixed[j].end
+            continue
+        here = p.job(j).location
+        times = [end[a] for a in p.predecessors(j)]
+        for m in robots[j]:
+            before = previous.get((m, j))
+            if before is None:
+                r = p.robot(m)
+                leg = p.travel(m, r.start_location, here) if r.start_location else 0
+                times.append(r.release_time + leg)
+            else:
+                times.append(end[before] + p.travel(m, p.job(before).location, here))
+        start[j] = max(times, default=Fraction(0))
+        end[j] = start[j] + max(p.duration(m, q) for m, q in robots[j].items())
+    jobs = {j: JobAssignment(j, plan[j], start[j], end[j], dict(robots[j])) for j in order}
+    return Schedule(jobs, {m: tuple(seq) for m, seq in sequences.items()})
+
+
+def _topological(blockers) -> list[str]:
+    waiting = {j: set(b) for j, b in blockers.items()}
+    ready = sorted(j for j, b in waiting.items() if not b)
+    order = []
+    while ready:
+        j = ready.pop()
+        order.append(j)
+        for other, b in waiting.items():
+            if j in b:
+                b.discard(j)
+                if not b:
+                    ready.append(other)
+    if len(order) != len(waiting):
+        stuck = sorted(set(waiting) - set(order))
+        raise RuntimeError(f'robot sequences and precedence form a cycle among {stuck}')
+    return order
