@@ -1,0 +1,333 @@
+"""Re-planning after off-nominal events (SPEC §2): the problem that remains, and its solution.
+
+A failure turns the executing mission into a smaller problem posed at `now`:
+
+- completed jobs leave, and precedence arcs out of them are dropped;
+- a running job whose robots are all healthy stays, as a `FixedJob` with its actual start,
+  plan and robots and its expected end;
+- a running job with a failed robot is aborted: it is redone from scratch, and its healthy
+  robots are free at `now`, at the job's location;
+- a completed jig job whose holder failed before the held job finished is voided (the hold
+  it set up is lost) and redone, and the held job, if running, is aborted;
+- a completed jig job whose held job has not finished (not started, or aborted) and whose
+  holders are healthy stays as a `FixedJob` of just its holders: the holders are still
+  holding, and only its holding arc forces them to go directly to the held job;
+- every healthy robot starts where it is, or where it is travelling to, released at
+  max(now, free_at); a failed robot is left out, so it gets nothing.
+
+A job the healthy robots cannot staff is reported in `Residual.blocked`, never raised: the
+robot may come back, and a later state then gives a solvable residual.
+"""
+
+from collections import Counter
+from collections.abc import Mapping
+from dataclasses import dataclass, field, replace
+from fractions import Fraction
+
+from fjsp_planner.core.problem import FixedJob, Job, Problem, Robot, max_staffed
+from fjsp_planner.core.schedule import JobAssignment, Schedule
+
+
+class StateError(ValueError):
+    """An execution state that contradicts its problem; `problems` lists every reason."""
+
+    def __init__(self, problems):
+        self.problems = list(problems)
+        super().__init__('\n'.join(self.problems))
+
+
+@dataclass(frozen=True)
+class RobotState:
+    name: str
+    healthy: bool
+    location: str | None
+    """Where it is, or where it is travelling to; None: never placed (may start anywhere)."""
+    free_at: Fraction
+    """When it can start something new: the end of its running job, or its arrival."""
+
+
+@dataclass(frozen=True)
+class ExecutionState:
+    now: Fraction
+    done: frozenset[str]
+    """Jobs completed."""
+    running: Mapping[str, JobAssignment]
+    """Jobs in progress: actual start, plan and robots; `end` is the expected end."""
+    robots: Mapping[str, RobotState]
+    """Every robot of the problem, by name."""
+
+
+@dataclass(frozen=True)
+class Residual:
+    problem: Problem | None
+    """What remains to plan; None when nothing remains or something is blocked."""
+    blocked: list[str]
+    """Why what remains cannot be done by the healthy robots, one reason per job."""
+    voided: list[str]
+    """Completed jig jobs to redo because a holder failed before the held job finished."""
+    aborted: list[str]
+    """Running jobs to redo from scratch: a robot on them failed, or their hold was lost."""
+    kept: list[str] = field(default_factory=list)
+    """Completed jig jobs kept as fixed jobs of their holders, which are still holding."""
+    failed: list[str] = field(default_factory=list)
+    """Robots left out of the residual problem."""
+
+    @property
+    def complete(self) -> bool:
+        """Every job is done: there is nothing left to plan."""
+        return self.problem is None and not self.blocked
+
+
+def residual_problem(problem: Problem, state: ExecutionState,
+                     previous: Schedule | None = None) -> Residual:
+    """The part of `problem` that remains in `state`, posed at `state.now`.
+
+    `previous` is the schedule being executed. It tells which robots did the completed jobs,
+    which matters only for a completed jig job whose held job has not finished; without it
+    such a state raises ValueError. A state naming unknown jobs, robots or locations, or
+    contradicting itself, raises `StateError` (a ValueError) listing every issue.
+    """
+    _raise_on_state_problems(problem, state)
+    healthy = {name for name, robot in state.robots.items() if robot.healthy}
+    aborted = {name for name, a in state.running.items() if not set(a.robots) <= healthy}
+    holds = _open_holds(problem, state, previous)
+    voided = {source for source, _, holders in holds if not set(holders) <= healthy}
+    aborted.update(target for source, target, _ in holds
+                   if source in voided and target in state.running)
+    fixed = {name: a for name, a in state.running.items() if name not in aborted}
+    kept = {}
+    for source, target, holders in holds:
+        if source not in voided and target not in fixed:
+            kept.setdefault(source, {}).update(holders)
+    _raise_on_hold_conflicts(kept, fixed)
+
+    order = [j.name for j in problem.jobs]
+    residual = Residual(
+        problem=None, blocked=[], voided=[j for j in order if j in voided],
+        aborted=[j for j in order if j in aborted], kept=[j for j in order if j in kept],
+        failed=[r.name for r in problem.robots if r.name not in healthy])
+    todo = [j for j in problem.jobs
+            if (j.name not in state.done or j.name in voided) and j.name not in fixed]
+    if not todo and not fixed:
+        return residual
+    blocked = _staffing_problems(problem, todo, healthy, kept, residual.failed)
+    if blocked:
+        return replace(residual, blocked=blocked)
+    posed = _pose(problem, state, previous, healthy, todo, fixed, kept, aborted)
+    return replace(residual, problem=posed)
+
+
+def _open_holds(problem, state, previous):
+    """(source, target, {holder: type}) for each holding arc whose source is done but whose
+    target is not: its holders are still holding, unless they failed."""
+    holds = []
+    for source, target, q in problem.holding:
+        if source not in state.done or target in state.done:
+            continue
+        if previous is None or source not in previous.jobs:
+            raise ValueError(f"job '{source}' is done and holds for '{target}', which is "
+                             f'not: pass the schedule being executed as `previous` to tell '
+                             f'who holds it')
+        robots = previous.jobs[source].robots
+        unknown = sorted(set(robots) - {r.name for r in problem.robots})
+        if unknown:
+            raise ValueError(f"previous schedule: job '{source}' names unknown robot(s) "
+                             + ', '.join(f"'{r}'" for r in unknown))
+        holds.append((source, target, {r: t for r, t in robots.items() if t == q}))
+    return holds
+
+
+def _raise_on_hold_conflicts(kept, fixed):
+    """A holder that is doing something else contradicts the hold it should keep."""
+    problems = []
+    holding = {}
+    for source, holders in kept.items():
+        for robot in holders:
+            if robot in holding:
+                problems.append(f"robot '{robot}' cannot hold for both '{holding[robot]}' "
+                                f"and '{source}'")
+            holding[robot] = source
+    for name, a in fixed.items():
+        for robot in a.robots:
+            if robot in holding:
+                problems.append(f"robot '{robot}' is running '{name}' while it should still "
+                                f"hold since '{holding[robot]}'")
+    if problems:
+        raise StateError(problems)
+
+
+def _staffing_problems(problem, todo, healthy, kept, failed) -> list[str]:
+    """Jobs to do that no plan lets the healthy robots staff, each with the reason.
+
+    A job held from a kept jig job must give its held operations to the holders, so the
+    rest of its plan is matched against the other healthy robots.
+    """
+    forced = {}
+    for source, target, q in problem.holding:
+        if source in kept:
+            forced.setdefault(target, {}).update(
+                {r: t for r, t in kept[source].items() if t == q})
+    names = [r.name for r in problem.robots if r.name in healthy]
+    why_short = f' (failed: {", ".join(failed)})' if failed else ''
+    problems = []
+    for job in todo:
+        holders = forced.get(job.name, {})
+        others = [r for r in names if r not in holders]
+        shortfalls = []
+        for index, plan in enumerate(job.plans):
+            rest = Counter(plan)
+            rest.subtract(holders.values())
+            if min(rest.values(), default=0) < 0:
+                shortfalls.append(f'plan {index} {sorted(plan)} has no place for the '
+                                  f'holders {_named(holders)}')
+                continue
+            rest_plan = list(rest.elements())
+            staffed = max_staffed(problem, rest_plan, others)
+            if staffed < len(rest_plan):
+                held = f' besides the holders {_named(holders)}' if holders else ''
+                shortfalls.append(f'plan {index} {sorted(plan)} needs {len(rest_plan)} '
+                                  f'distinct robots able to do {sorted(rest_plan)}{held}; '
+                                  f'{staffed} healthy can')
+        if len(shortfalls) == len(job.plans):
+            problems.append(f"job '{job.name}' cannot be staffed: " + '; '.join(shortfalls)
+                            + why_short)
+    return problems
+
+
+def _named(robots: Mapping[str, int]) -> str:
+    return ', '.join(f"'{r}'" for r in sorted(robots))
+
+
+def _pose(problem, state, previous, healthy, todo, fixed, kept, aborted) -> Problem:
+    """The residual `Problem`: todo + fixed running + kept jig jobs, healthy robots only."""
+    now = state.now
+    place = {}
+    for name, a in fixed.items():
+        place.update(dict.fromkeys(a.robots, problem.job(name).location))
+    for name, holders in kept.items():
+        place.update(dict.fromkeys(holders, problem.job(name).location))
+    freed = {}
+    for name in aborted:
+        freed.update(dict.fromkeys(state.running[name].robots, problem.job(name).location))
+
+    robots = []
+    for robot in problem.robots:
+        if robot.name not in healthy:
+            continue
+        s = state.robots[robot.name]
+        location, release = s.location, max(now, s.free_at)
+        if robot.name in freed:
+            location, release = freed[robot.name], now
+        # A robot's route begins at its fixed job, which is exempt from start-location travel.
+        location = place.get(robot.name, location)
+        robots.append(Robot(robot.name, robot.type, robot.speed, location, release))
+
+    jobs = list(todo) + [problem.job(name) for name in fixed]
+    # A job still running at `now` cannot end before it, whatever was expected.
+    pinned = {name: FixedJob(a.plan, a.start, max(a.end, now), dict(a.robots))
+              for name, a in fixed.items()}
+    for name, holders in kept.items():
+        # Only the holders are still bound to the jig job: a plan of just their operations
+        # keeps the fixed job consistent, and lets its other robots go on freely.
+        job = problem.job(name)
+        jobs.append(Job(job.name, job.location, (tuple(sorted(holders.values())),)))
+        # The holders have been busy holding since the jig job ended, so it ends at `now`
+        # for them: the held job then cannot start in the past (the solvers apply release
+        # times only to a robot's first job, and this fixed job comes first).
+        done = previous.jobs[name]
+        start = min(done.start, now - (done.end - done.start))
+        pinned[name] = FixedJob(0, start, now, dict(holders))
+    names = {j.name for j in jobs}
+    scheduled = {j.name for j in todo}
+    precedence = tuple((a, b) for a, b in problem.precedence if a in names and b in scheduled)
+    holding = tuple((a, b, q) for a, b, q in problem.holding if a in names and b in scheduled)
+    order = {j.name: i for i, j in enumerate(problem.jobs)}
+    jobs.sort(key=lambda j: order[j.name])
+    # No `panels`: once execution has begun, the panels are no longer identical copies.
+    return Problem(
+        operation_types=problem.operation_types,
+        robot_types=problem.robot_types,
+        robots=tuple(robots),
+        jobs=tuple(jobs),
+        distances=problem.distances,
+        precedence=precedence,
+        holding=holding,
+        locomote=problem.locomote,
+        time_overrides={k: v for k, v in problem.time_overrides.items() if k[0] in healthy},
+        fixed=pinned,
+        name=f'{problem.name}@{now}',
+    )
+
+
+def _raise_on_state_problems(problem: Problem, state: ExecutionState) -> None:
+    jobs = {j.name for j in problem.jobs}
+    robots = {r.name for r in problem.robots}
+    locations = set(problem.locations())
+    problems = []
+    if state.now < 0:
+        problems.append(f'now is negative ({state.now})')
+    for name in sorted(set(state.done) - jobs):
+        problems.append(f"done job '{name}' is not a job")
+    for name in sorted(set(state.done) & set(state.running)):
+        problems.append(f"job '{name}' is both done and running")
+    busy = {}
+    for name, a in state.running.items():
+        if name not in jobs:
+            problems.append(f"running job '{name}' is not a job")
+            continue
+        if a.job != name:
+            problems.append(f"running job '{name}' carries the assignment of '{a.job}'")
+        plans = problem.job(name).plans
+        if not 0 <= a.plan < len(plans):
+            problems.append(f"running job '{name}': no plan {a.plan}")
+        elif sorted(a.robots.values()) != sorted(plans[a.plan]):
+            problems.append(f"running job '{name}': robots do {sorted(a.robots.values())}, "
+                            f'but plan {a.plan} is {sorted(plans[a.plan])}')
+        if a.end < a.start:
+            problems.append(f"running job '{name}' ends before it starts")
+        for robot in a.robots:
+            if robot not in robots:
+                problems.append(f"running job '{name}' names unknown robot '{robot}'")
+            elif robot in busy:
+                problems.append(f"robot '{robot}' runs both '{busy[robot]}' and '{name}'")
+            busy[robot] = name
+    for name, r in state.robots.items():
+        if name not in robots:
+            problems.append(f"robot state for unknown robot '{name}'")
+        if r.name != name:
+            problems.append(f"robot state under '{name}' is named '{r.name}'")
+        if r.location is not None and r.location not in locations:
+            problems.append(f"robot '{name}' is at unknown location '{r.location}'")
+    for name in sorted(robots - set(state.robots)):
+        problems.append(f"no state for robot '{name}'")
+    if problems:
+        raise StateError(problems)
+
+
+def simulated_state(problem: Problem, schedule: Schedule, now: Fraction,
+                    failed=frozenset(), done=frozenset()) -> ExecutionState:
+    """The state reached at `now` by executing `schedule` exactly as planned, with the
+    `failed` robots failing at `now`; `done` adds jobs finished before `schedule` was made.
+
+    A robot leaves as soon as it is free and waits at its next job (`Schedule.visits`); one
+    that has not started its first job yet and has no start location is still unplaced.
+    """
+    now = Fraction(now)
+    finished = set(done) | {name for name, a in schedule.jobs.items() if a.end <= now}
+    running = {name: a for name, a in schedule.jobs.items() if a.start <= now < a.end}
+    robots = {}
+    for robot in problem.robots:
+        location, free_at = robot.start_location, robot.release_time
+        for visit in schedule.visits(problem, robot.name):
+            here = problem.job(visit.job).location
+            if visit.end <= now:
+                location, free_at = here, visit.end
+                continue
+            if visit.start <= now:
+                location, free_at = here, visit.end
+            elif location is not None and visit.travel_start <= now:
+                location, free_at = here, visit.arrival
+            break
+        robots[robot.name] = RobotState(robot.name, robot.name not in failed, location,
+                                        max(now, free_at))
+    return ExecutionState(now, frozenset(finished), running, robots)

@@ -1,0 +1,223 @@
+"""Re-planning after a failure (SPEC §2), on an instance small enough to re-plan on paper.
+
+    locations p, q at distance 4; type 2 is locomote; every robot is an Arm of speed 1
+    (hold 2, weld 3, travel = distance) starting at p at time 0
+    job  where  plan    after      holding
+    J    p      [0]                J -> W, type 0: J's holder goes directly to W
+    P    p      [1]
+    W    p      [0, 1]  J, P
+    F    q      [1]     W
+
+    The plan (optimal, makespan 9: J/P, then W, then F, lasting 3 + 3 + 3):
+    J [0, 2] A; P [0, 3] B; W [3, 6] A holds, B welds; F [6, 9] C, who travels p -> q in
+    [0, 4] and waits. Each test fails robots at a time `now` of that plan and re-plans; the
+    docstrings give the hand-computed optimum of what remains.
+"""
+
+from dataclasses import replace
+from fractions import Fraction
+from pathlib import Path
+
+import pytest
+
+from fjsp_planner.core.problem import Job, Problem, Robot
+from fjsp_planner.core.replan import (
+    ExecutionState,
+    RobotState,
+    StateError,
+    residual_problem,
+    simulated_state,
+)
+from fjsp_planner.core.schedule import JobAssignment, Schedule
+from fjsp_planner.core.validate import validate
+
+SCENARIO = Path(__file__).resolve().parents[2] / 'config' / 'scenarios' / 'solar_panel.yaml'
+
+
+def make_problem() -> Problem:
+    return Problem(
+        operation_types={0: 'hold', 1: 'weld', 2: 'locomote'},
+        robot_types={'Arm': {0: Fraction(2), 1: Fraction(3), 2: Fraction(1)}},
+        robots=tuple(Robot(name, 'Arm', start_location='p') for name in 'ABC'),
+        jobs=(Job('J', 'p', ((0,),)), Job('P', 'p', ((1,),)), Job('W', 'p', ((0, 1),)),
+              Job('F', 'q', ((1,),))),
+        distances={('p', 'q'): Fraction(4), ('q', 'p'): Fraction(4)},
+        precedence=(('J', 'W'), ('P', 'W'), ('W', 'F')),
+        holding=(('J', 'W', 0),),
+        locomote=2,
+        name='small',
+    )
+
+
+def assign(job, start, end, robots) -> JobAssignment:
+    return JobAssignment(job, 0, Fraction(start), Fraction(end), robots)
+
+
+PLAN = Schedule(
+    jobs={'J': assign('J', 0, 2, {'A': 0}), 'P': assign('P', 0, 3, {'B': 1}),
+          'W': assign('W', 3, 6, {'A': 0, 'B': 1}), 'F': assign('F', 6, 9, {'C': 1})},
+    sequences={'A': ('J', 'W'), 'B': ('P', 'W'), 'C': ('F',)},
+)
+
+
+@pytest.fixture(scope='module')
+def small():
+    return make_problem()
+
+
+def at(problem, now, failed=(), schedule=PLAN):
+    return simulated_state(problem, schedule, Fraction(now), failed=frozenset(failed))
+
+
+def test_the_plan_is_valid_and_simulates_as_drawn(small):
+    assert validate(small, PLAN) == []
+    state = at(small, Fraction(5, 2))
+    assert state.done == {'J'}
+    assert set(state.running) == {'P'}
+    assert state.robots['A'] == RobotState('A', True, 'p', Fraction(5, 2))
+    assert state.robots['B'] == RobotState('B', True, 'p', Fraction(3))
+    assert state.robots['C'] == RobotState('C', True, 'q', Fraction(4))
+
+
+def test_failure_while_travelling_keeps_running_jobs(small):
+    """C fails on its way to q at 1: J and P go on, F has to wait for A or B to come."""
+    residual = residual_problem(small, at(small, 1, {'C'}), PLAN)
+    p = residual.problem
+    assert residual.failed == ['C']
+    assert residual.aborted == residual.voided == residual.blocked == []
+    assert [r.name for r in p.robots] == ['A', 'B']
+    assert set(p.fixed) == {'J', 'P'}
+    assert p.fixed['J'].robots == {'A': 0} and p.fixed['J'].end == 2
+    assert p.robot('A').start_location == 'p'
+    assert p.robot('B').release_time == 3
+    assert set(p.precedence) == {('J', 'W'), ('P', 'W'), ('W', 'F')}
+
+
+def test_failure_while_working_aborts_the_job(small):
+    """B fails at 1 in P: P is redone, by C, the only robot not bound to hold for W."""
+    residual = residual_problem(small, at(small, 1, {'B'}), PLAN)
+    p = residual.problem
+    assert residual.aborted == ['P']
+    assert set(p.fixed) == {'J'}
+    assert {j.name for j in p.jobs} == {'J', 'P', 'W', 'F'}
+    assert p.robot('C') == Robot('C', 'Arm', Fraction(1), 'q', Fraction(4))
+    assert ('J', 'W', 0) in p.holding
+
+
+def test_failure_while_holding_voids_the_jig_job(small):
+    """A fails at 5/2 while holding since J ended at 2: J is redone, and W after it."""
+    residual = residual_problem(small, at(small, Fraction(5, 2), {'A'}), PLAN)
+    p = residual.problem
+    assert residual.voided == ['J']
+    assert residual.aborted == [] and residual.kept == []
+    assert p.fixed.keys() == {'P'}
+    assert {j.name for j in p.jobs} == {'J', 'P', 'W', 'F'}
+    assert ('J', 'W', 0) in p.holding
+
+
+def test_healthy_holder_keeps_holding(small):
+    """C fails at 5/2 while A holds since J: J stays, fixed with its holder only, so that the
+    holding arc still sends A directly to W."""
+    residual = residual_problem(small, at(small, Fraction(5, 2), {'C'}), PLAN)
+    p = residual.problem
+    assert residual.kept == ['J'] and residual.voided == []
+    assert p.job('J').plans == ((0,),)
+    assert p.fixed['J'].robots == {'A': 0}
+    # The hold lasts until now, so W cannot start in the past.
+    assert p.fixed['J'].start == 0 and p.fixed['J'].end == Fraction(5, 2)
+    assert p.holding == (('J', 'W', 0),)
+
+
+def test_aborted_held_job_keeps_its_holder(small):
+    """B (welding W) fails at 4: W is redone, and A, still holding since J, must be in it."""
+    residual = residual_problem(small, at(small, 4, {'B'}), PLAN)
+    p = residual.problem
+    assert residual.aborted == ['W'] and residual.kept == ['J']
+    assert {j.name for j in p.jobs} == {'J', 'W', 'F'}
+    assert p.fixed.keys() == {'J'}
+    # P is done and gone, so is its arc; J's arc stays, harmless since J ended by now.
+    assert set(p.precedence) == {('J', 'W'), ('W', 'F')}
+    assert p.robot('A').release_time == 4 and p.robot('A').start_location == 'p'
+
+
+def test_jig_job_holding_for_a_running_job_is_gone(small):
+    """At 4, W runs on healthy A and B: the hold is inside W now, J is simply done."""
+    residual = residual_problem(small, at(small, 4, {'C'}), PLAN)
+    assert residual.kept == []
+    assert {j.name for j in residual.problem.jobs} == {'W', 'F'}
+    assert residual.problem.holding == ()
+
+
+def test_failure_after_the_robots_last_job(small):
+    """A fails at 7, after W: only F, running on C, remains."""
+    residual = residual_problem(small, at(small, 7, {'A'}), PLAN)
+    p = residual.problem
+    assert [j.name for j in p.jobs] == ['F'] and p.fixed.keys() == {'F'}
+    assert p.precedence == () and not residual.complete
+
+
+def test_two_failures_block_with_the_reason(small):
+    residual = residual_problem(small, at(small, 1, {'A', 'B'}), PLAN)
+    assert residual.problem is None and not residual.complete
+    assert residual.aborted == ['J', 'P']
+    assert residual.blocked == [
+        "job 'W' cannot be staffed: plan 0 [0, 1] needs 2 distinct robots able to do "
+        '[0, 1]; 1 healthy can (failed: A, B)']
+
+
+def test_recovered_robot_unblocks(small):
+    state = at(small, 1, {'A', 'B'})
+    later = ExecutionState(Fraction(5), state.done, {}, {
+        **state.robots,
+        'B': RobotState('B', True, 'p', Fraction(5)),
+        'C': RobotState('C', True, 'q', Fraction(5))})
+    residual = residual_problem(small, later, PLAN)
+    assert residual.blocked == []
+    assert [r.name for r in residual.problem.robots] == ['B', 'C']
+    assert residual.problem.fixed == {}
+
+
+def test_everything_done_is_complete(small):
+    residual = residual_problem(small, at(small, 9), PLAN)
+    assert residual.complete and residual.problem is None
+
+
+def test_kept_jig_job_needs_the_executed_schedule(small):
+    with pytest.raises(ValueError, match="job 'J' is done and holds for 'W'"):
+        residual_problem(small, at(small, Fraction(5, 2), {'C'}))
+
+
+def _with_robot(state, robot_state):
+    return replace(state, robots={**state.robots, robot_state.name: robot_state})
+
+
+BAD_STATES = [
+    ('done names an unknown job', lambda s: replace(s, done=frozenset({'J', 'X'})),
+     "done job 'X' is not a job"),
+    ('running names an unknown job',
+     lambda s: replace(s, running={'X': assign('X', 0, 3, {'B': 1})}),
+     "running job 'X' is not a job"),
+    ('a job both done and running', lambda s: replace(s, done=frozenset({'J', 'P'})),
+     "job 'P' is both done and running"),
+    ('a running job with an unknown robot',
+     lambda s: replace(s, running={'P': assign('P', 0, 3, {'Z': 1})}),
+     "running job 'P' names unknown robot 'Z'"),
+    ('robots that do not match the plan',
+     lambda s: replace(s, running={'P': assign('P', 0, 3, {'B': 0})}),
+     r"running job 'P': robots do \[0\], but plan 0 is \[1\]"),
+    ('a state for an unknown robot',
+     lambda s: _with_robot(s, RobotState('Z', True, None, Fraction(0))),
+     "robot state for unknown robot 'Z'"),
+    ('a robot without a state',
+     lambda s: replace(s, robots={k: v for k, v in s.robots.items() if k != 'C'}),
+     "no state for robot 'C'"),
+    ('an unknown location', lambda s: _with_robot(s, RobotState('C', True, 'moon', Fraction(4))),
+     "robot 'C' is at unknown location 'moon'"),
+]
+
+
+@pytest.mark.parametrize(('why', 'change', 'message'), BAD_STATES,
+                         ids=[row[0] for row in BAD_STATES])
+def test_bad_state_is_named(small, why, change, message):
+    with pytest.raises(StateError, match=message):
+        residual_problem(small, change(at(small, Fraction(5, 2))), PLAN)
