@@ -49,14 +49,23 @@ MAX_GRID = 10 ** 6
 
 
 def solve_mip(problem: Problem, time_limit: float = 10.0, backend: str = 'SCIP',
-              workers: int = 1, hint: Schedule | None = None) -> Result:
-    """Minimise the makespan of `problem` with the §IV MIP on `backend` ('SCIP' or 'HIGHS')."""
+              workers: int = 1, hint: Schedule | None = None, log: bool = False) -> Result:
+    """Minimise the makespan of `problem` with the §IV MIP on `backend` ('SCIP' or 'HIGHS').
+
+    `log` lets the backend print its progress to standard output (benchmarks read it).
+    """
     backend = backend.upper()
     if backend not in BACKENDS:
         raise ValueError(f"unknown MIP backend '{backend}'; choose one of {', '.join(BACKENDS)}")
     solver = pywraplp.Solver.CreateSolver(backend)
     if solver is None:
         raise RuntimeError(f"OR-Tools was built without the '{backend}' MIP backend")
+    if log:
+        solver.EnableOutput()
+    elif backend == 'HIGHS':
+        # HiGHS prints a banner even when OR-Tools suppresses output; this silences it (the
+        # call reports failure but takes effect).
+        solver.SetSolverSpecificParametersAsString('output_flag = false')
     started = time.perf_counter()
     model = _Model(problem, solver, hint)
     solver.SetTimeLimit(max(1, int(time_limit * 1000)))
