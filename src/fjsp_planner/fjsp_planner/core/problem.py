@@ -64,6 +64,9 @@ class Problem:
     time_overrides: Mapping[tuple[str, int], Fraction] = field(default_factory=dict)
     """(robot, operation type) -> time, replacing the robot type's efficiency."""
     fixed: Mapping[str, FixedJob] = field(default_factory=dict)
+    panels: tuple[tuple[str, ...], ...] = ()
+    """Identical copies of one job set (SPEC §1.2), job k of each copy matching; solvers
+    may use this to break the symmetry between copies and to bound moves between them."""
     name: str = 'problem'
 
     def __post_init__(self):
@@ -174,6 +177,13 @@ def _structural_problems(p: Problem) -> list[str]:
                 problems.append(f"holding arc ('{a}', '{b}', {q}) names unknown job '{name}'")
         if q not in p.operation_types:
             problems.append(f"holding arc ('{a}', '{b}', {q}): unknown operation type {q}")
+    sizes = {len(panel) for panel in p.panels}
+    if len(sizes) > 1:
+        problems.append(f'panels must be copies of one job set; their sizes differ: {sizes}')
+    for panel in p.panels:
+        for name in panel:
+            if name not in jobs:
+                problems.append(f"panel lists unknown job '{name}'")
     for name, fixed in p.fixed.items():
         if name not in jobs:
             problems.append(f"fixed job '{name}' is not a job")

@@ -1,0 +1,163 @@
+"""fjsp-solve: plan a scenario from the command line."""
+
+import argparse
+import json
+import sys
+from fractions import Fraction
+from pathlib import Path
+
+from fjsp_planner.core.problem import ProblemError
+from fjsp_planner.core.schedule import Result
+from fjsp_planner.core.solve import SOLVERS, solve
+from fjsp_planner.core.validate import validate
+
+EXIT_BAD_INPUT = 2
+EXIT_INVALID_SCHEDULE = 3
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(
+        prog='fjsp-solve', description='Plan which robot does what, when, for a scenario '
+        '(YAML, see docs/scenario-format.md) or a standard .fjs instance.')
+    parser.add_argument('scenario', help='scenario .yaml or FJSP .fjs file')
+    parser.add_argument('--panels', type=_positive_int, help='repeat the jobs N times')
+    parser.add_argument('--shift', type=_non_negative, help='distance between panels')
+    parser.add_argument('--time-limit', type=_positive, default=10.0, metavar='S')
+    parser.add_argument('--workers', type=_positive_int, default=2, metavar='K')
+    parser.add_argument('--solver', choices=SOLVERS, default='cpsat')
+    parser.add_argument('--mip-backend', choices=('SCIP', 'HIGHS'), default='SCIP')
+    parser.add_argument('--json', type=Path, metavar='OUT', help='write the result as JSON')
+    parser.add_argument('--gantt', type=Path, metavar='OUT.png', help='draw the schedule')
+    args = parser.parse_args(argv)
+    try:
+        problem = _load(args)
+    except ProblemError as error:
+        print('fjsp-solve: invalid scenario:', file=sys.stderr)
+        for problem_text in error.problems:
+            print(f'  - {problem_text}', file=sys.stderr)
+        return EXIT_BAD_INPUT
+    result = solve(problem, solver=args.solver, time_limit=args.time_limit,
+                   workers=args.workers, mip_backend=args.mip_backend)
+    if result.schedule is not None:
+        violations = validate(problem, result.schedule)
+        if violations:
+            print('fjsp-solve: the solver returned an invalid schedule:', file=sys.stderr)
+            for violation in violations:
+                print(f'  - {violation}', file=sys.stderr)
+            return EXIT_INVALID_SCHEDULE
+        print(format_table(problem, result))
+    print(status_line(result))
+    for note in result.notes:
+        print(f'note: {note}')
+    if args.json:
+        args.json.write_text(json.dumps(result_json(problem, result), indent=2) + '\n')
+    if args.gantt and result.schedule is not None:
+        from fjsp_planner.core.gantt import draw_gantt
+
+        draw_gantt(problem, result.schedule, args.gantt,
+                   title=f'{problem.name}: makespan {_number(result.makespan):g}')
+    return 0 if result.schedule is not None else 1
+
+
+def _load(args):
+    path = Path(args.scenario)
+    if not path.is_file():
+        raise ProblemError([f'{path}: no such file'])
+    if path.suffix == '.fjs':
+        from fjsp_planner.core.fjs import load_fjs
+        from fjsp_planner.core.scenario import repeat_panels
+
+        problem = load_fjs(path)
+        return repeat_panels(problem, args.panels or 1, args.shift or 0)
+    from fjsp_planner.core.scenario import load_scenario
+
+    return load_scenario(path, panels=args.panels, shift=args.shift)
+
+
+def status_line(result: Result) -> str:
+    parts = [f'status {result.status.value}', f'solver {result.solver}']
+    if result.makespan is not None:
+        parts.append(f'makespan {_number(result.makespan):g}')
+    if result.lower_bound is not None:
+        parts.append(f'bound {_number(result.lower_bound):g}')
+    if result.gap is not None:
+        parts.append(f'gap {100 * result.gap:.1f}%')
+    parts.append(f'time {result.solve_seconds:.2f} s')
+    return ', '.join(parts)
+
+
+def format_table(problem, result: Result) -> str:
+    lines = [f"{'robot':<12}{'job':<10}{'operation':<24}{'travel':>16}{'start':>9}{'end':>9}"]
+    for robot in problem.robots:
+        for visit in result.schedule.visits(problem, robot.name):
+            q = result.schedule.jobs[visit.job].robots[robot.name]
+            travel = (f'{_number(visit.travel_start):g}-{_number(visit.arrival):g}'
+                      if visit.arrival > visit.travel_start else '-')
+            lines.append(f'{robot.name:<12}{visit.job:<10}{problem.operation_types[q]:<24}'
+                         f'{travel:>16}{_number(visit.start):>9g}{_number(visit.end):>9g}')
+        if not result.schedule.sequences.get(robot.name):
+            lines.append(f'{robot.name:<12}(no jobs)')
+    return '\n'.join(lines)
+
+
+def result_json(problem, result: Result) -> dict:
+    schedule = result.schedule
+    return {
+        'scenario': problem.name,
+        'solver': result.solver,
+        'status': result.status.value,
+        'makespan': _number(result.makespan),
+        'lower_bound': _number(result.lower_bound),
+        'gap': result.gap,
+        'solve_seconds': result.solve_seconds,
+        'first_solution_seconds': result.first_solution_seconds,
+        'notes': list(result.notes),
+        'jobs': [] if schedule is None else [
+            {'name': a.job, 'plan': a.plan, 'start': _number(a.start), 'end': _number(a.end),
+             'robots': dict(a.robots)}
+            for a in sorted(schedule.jobs.values(), key=lambda a: (a.start, a.job))],
+        'robots': {} if schedule is None else {
+            r.name: [{'job': v.job, 'travel_start': _number(v.travel_start),
+                      'arrival': _number(v.arrival), 'start': _number(v.start),
+                      'end': _number(v.end)} for v in schedule.visits(problem, r.name)]
+            for r in problem.robots},
+    }
+
+
+def _number(value: Fraction | None):
+    """Exact integers stay integers; other times become floats (JSON has no fractions)."""
+    if value is None:
+        return None
+    return int(value) if value.denominator == 1 else float(value)
+
+
+def _positive_int(text):
+    value = _parse(text, int)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f'must be a positive integer, got {text!r}')
+    return value
+
+
+def _positive(text):
+    value = _parse(text, float)
+    if not value > 0:
+        raise argparse.ArgumentTypeError(f'must be positive, got {text!r}')
+    return value
+
+
+def _non_negative(text):
+    value = _parse(text, Fraction)
+    if not value >= 0:
+        raise argparse.ArgumentTypeError(f'must not be negative, got {text!r}')
+    return value
+
+
+def _parse(text, kind):
+    try:
+        return kind(text)
+    except (ValueError, ZeroDivisionError):
+        raise argparse.ArgumentTypeError(f'not a number: {text!r}') from None
+
+
+if __name__ == '__main__':
+    sys.exit(main())

@@ -1,0 +1,354 @@
+"""CP-SAT model of SPEC §1.
+
+Per job: one master start/end shared by an optional interval on every robot able to work
+on it (a robot on a job is busy from the job's start to its end). Per robot: one circuit
+over a depot and its jobs; an arc a -> b forces end_a + travel(a, b) <= start_b, and a
+holding arc (j, j', q) forces the arc j -> j' for every robot doing type q in j.
+
+CP-SAT needs integers: times are scaled by the least common multiple of the durations'
+and travel times' denominators (exact for the paper: 30), capped at MAX_SCALE, beyond which
+durations are rounded up so the exact schedule read back can only be looser than the grid.
+"""
+
+import math
+import time
+from fractions import Fraction
+
+from ortools.sat.python import cp_model
+
+from fjsp_planner.core.problem import Problem
+from fjsp_planner.core.schedule import JobAssignment, Result, Schedule, Status
+
+MAX_SCALE = 1000
+KEEP_SHARE = 0.3
+"""Share of the time limit spent, after the makespan search, keeping previous assignments."""
+
+
+def solve_cpsat(problem: Problem, time_limit=10.0, workers=2, hint: Schedule | None = None,
+                keep: Schedule | None = None, upper_bound: Schedule | None = None,
+                log=False) -> Result:
+    """Minimise the makespan; with `keep`, then prefer `keep`'s (job, robot) assignments.
+
+    `upper_bound` is a valid schedule (e.g. greedy) that sets the horizon and is hinted
+    unless `hint` is given.
+    """
+    began = time.monotonic()
+    model = _Model(problem, upper_bound)
+    if hint is not None or upper_bound is not None:
+        model.add_hint(hint or upper_bound)
+    model.model.minimize(model.makespan)
+    keep_time = time_limit * KEEP_SHARE if keep is not None else 0.0
+    solver, recorder, status = _run(model.model, time_limit - keep_time, workers, log)
+    if status in ('INFEASIBLE',):
+        return Result(Status.INFEASIBLE, None, None, time.monotonic() - began, None, 'cpsat',
+                      notes=model.notes)
+    if status not in ('OPTIMAL', 'FEASIBLE'):
+        if status == 'MODEL_INVALID':
+            raise RuntimeError(f'CP-SAT rejected the model: {model.model.validate()}')
+        return Result(Status.UNKNOWN, None, None, time.monotonic() - began, None, 'cpsat',
+                      notes=model.notes)
+    best = solver.value(model.makespan)
+    bound = Fraction(math.ceil(solver.best_objective_bound), model.scale)
+    schedule = model.read(solver)
+    if keep is not None and keep_time > 0:
+        schedule = _keep_assignments(model, solver, best, keep, keep_time, workers, log) \
+            or schedule
+    proven = status == 'OPTIMAL'
+    makespan = schedule.makespan
+    lower_bound = min(bound, makespan) if model.exact else bound
+    return Result(
+        Status.OPTIMAL if proven and model.exact else Status.FEASIBLE,
+        makespan, lower_bound, time.monotonic() - began, schedule, 'cpsat',
+        first_solution_seconds=recorder.first, notes=model.notes)
+
+
+def _run(model, time_limit, workers, log):
+    solver = cp_model.CpSolver()
+    solver.parameters.max_time_in_seconds = max(0.01, time_limit)
+    solver.parameters.num_workers = workers
+    solver.parameters.log_search_progress = log
+    recorder = _FirstSolution()
+    # status_name() without an argument is broken in ortools 9.15; name the returned status.
+    status = solver.solve(model, recorder).name
+    return solver, recorder, status
+
+
+class _FirstSolution(cp_model.CpSolverSolutionCallback):
+    def __init__(self):
+        super().__init__()
+        self.first = None
+
+    def on_solution_callback(self):
+        if self.first is None:
+            self.first = self.wall_time
+
+
+def _keep_assignments(model, solver, best, keep, time_limit, workers, log):
+    """Among schedules no longer than `best`, the one keeping most of `keep`'s robots."""
+    kept = [model.on_job[j, r] for j, a in keep.jobs.items() for r in a.robots
+            if (j, r) in model.on_job]
+    if not kept:
+        return None
+    model.model.clear_hints()
+    model.add_hint(model.read(solver))
+    model.model.add(model.makespan <= best)
+    model.model.maximize(sum(kept))
+    second, _, status = _run(model.model, time_limit, workers, log)
+    if status not in ('OPTIMAL', 'FEASIBLE'):
+        return None
+    return model.read(second)
+
+
+class _Model:
+    def __init__(self, problem: Problem, upper_bound: Schedule | None):
+        self.problem = problem
+        self.model = cp_model.CpModel()
+        self.notes = ()
+        self.scale, self.exact = self._choose_scale()
+        if not self.exact:
+            self.notes += (f'durations rounded up to a 1/{self.scale} time grid; the lower '
+                           'bound is that of the rounded model',)
+        else:
+            self.notes += (f'exact on a 1/{self.scale} time grid',)
+        self.horizon = self._horizon(upper_bound)
+        self.robots = [r.name for r in problem.robots]
+        self.start, self.end, self.plan = {}, {}, {}
+        self.does = {}
+        """(job, plan, op type, robot) -> literal: the robot does a type-q operation."""
+        self.on_job = {}
+        self.arcs = {}
+        self.route_nodes = {}
+        """robot -> the jobs on its circuit, in circuit node order."""
+        self._jobs()
+        self._precedence()
+        self._routes()
+        self._holding()
+        self.makespan = self.model.new_int_var(0, self.horizon, 'makespan')
+        for name in self.end:
+            self.model.add(self.makespan >= self.end[name])
+        self._panels()
+
+    def ticks(self, value: Fraction) -> int:
+        return math.ceil(value * self.scale)
+
+    def _choose_scale(self):
+        p = self.problem
+        values = [p.duration(r.name, q) for r in p.robots for q in p.operation_types]
+        locations = p.locations()
+        values += [p.travel(r.name, a, b) for r in p.robots for a in locations
+                   for b in locations]
+        denominators = {v.denominator for v in values if v is not None}
+        scale = math.lcm(*denominators) if denominators else 1
+        if scale > MAX_SCALE:
+            return MAX_SCALE, False
+        others = [r.release_time for r in p.robots]
+        others += [t for f in p.fixed.values() for t in (f.start, f.end)]
+        return scale, all((v * scale).denominator == 1 for v in others)
+
+    def _horizon(self, upper_bound):
+        from fjsp_planner.core.greedy import serial_upper_bound
+
+        if upper_bound is None:
+            return self.ticks(serial_upper_bound(self.problem))
+        slack = 0 if self.exact else 2 * len(self.problem.jobs) + 2
+        return self.ticks(upper_bound.makespan) + slack
+
+    def _jobs(self):
+        p, m = self.problem, self.model
+        for job in p.jobs:
+            name = job.name
+            fixed = p.fixed.get(name)
+            if fixed is not None:
+                fixed_ticks = (math.floor(fixed.start * self.scale), self.ticks(fixed.end))
+                start, end = (m.new_constant(t) for t in fixed_ticks)
+            else:
+                start = m.new_int_var(0, self.horizon, f'start_{name}')
+                end = m.new_int_var(0, self.horizon, f'end_{name}')
+            self.start[name], self.end[name] = start, end
+            plans = []
+            for index, plan in enumerate(job.plans):
+                chosen = (m.new_constant(int(index == fixed.plan)) if fixed is not None
+                          else m.new_bool_var(f'plan_{name}_{index}'))
+                self.plan[name, index] = chosen
+                plans.append(chosen)
+                for q in set(plan):
+                    able = [r for r in self.robots if p.duration(r, q) is not None]
+                    for r in able:
+                        if fixed is not None:
+                            value = int(index == fixed.plan and fixed.robots.get(r) == q)
+                            self.does[name, index, q, r] = m.new_constant(value)
+                        else:
+                            self.does[name, index, q, r] = m.new_bool_var(
+                                f'does_{name}_{index}_{q}_{r}')
+                    m.add(sum(self.does[name, index, q, r] for r in able)
+                          == plan.count(q) * chosen)
+            m.add_exactly_one(plans)
+            if fixed is None:
+                duration = m.new_int_var(0, self.horizon, f'duration_{name}')
+                m.add(end == start + duration)
+            else:
+                duration = fixed_ticks[1] - fixed_ticks[0]
+            longest = []
+            for r in self.robots:
+                mine = [(lit, q) for (j, _, q, robot), lit in self.does.items()
+                        if j == name and robot == r]
+                if not mine:
+                    continue
+                on = m.new_bool_var(f'on_{name}_{r}')
+                m.add(on == sum(lit for lit, _ in mine))
+                self.on_job[name, r] = on
+                longest.append(sum(lit * self.ticks(p.duration(r, q)) for lit, q in mine))
+                m.new_optional_interval_var(start, duration, end, on, f'busy_{name}_{r}')
+            if fixed is None:
+                m.add_max_equality(duration, longest)
+
+    def _precedence(self):
+        for a, b in self.problem.precedence:
+            self.model.add(self.start[b] >= self.end[a])
+
+    def _ancestors(self):
+        before = {j.name: set() for j in self.problem.jobs}
+        arcs = list(self.problem.precedence) + [(a, b) for a, b, _ in self.problem.holding]
+        changed = True
+        while changed:
+            changed = False
+            for a, b in arcs:
+                grown = before[b] | before[a] | {a}
+                if grown != before[b]:
+                    before[b], changed = grown, True
+        return before
+
+    def _routes(self):
+        p, m = self.problem, self.model
+        ancestors = self._ancestors()
+        for robot in p.robots:
+            r = robot.name
+            jobs = [j.name for j in p.jobs if (j.name, r) in self.on_job]
+            self.route_nodes[r] = jobs
+            if not jobs:
+                continue
+            node = {name: i + 1 for i, name in enumerate(jobs)}
+            used = m.new_bool_var(f'used_{r}')
+            m.add_max_equality(used, [self.on_job[j, r] for j in jobs])
+            arcs = [(0, 0, ~used)]
+            for a in jobs:
+                on = self.on_job[a, r]
+                arcs.append((node[a], node[a], ~on))
+                first = m.new_bool_var(f'first_{a}_{r}')
+                arcs.append((0, node[a], first))
+                arcs.append((node[a], 0, m.new_bool_var(f'last_{a}_{r}')))
+                if a not in p.fixed:
+                    ready = robot.release_time
+                    if robot.start_location is not None:
+                        ready += p.travel(r, robot.start_location, p.job(a).location)
+                    m.add(self.start[a] >= self.ticks(ready)).only_enforce_if(first)
+                for b in jobs:
+                    if a == b or b in ancestors[a] or (b in p.fixed and a not in p.fixed):
+                        continue
+                    arc = m.new_bool_var(f'next_{a}_{b}_{r}')
+                    self.arcs[a, b, r] = arc
+                    arcs.append((node[a], node[b], arc))
+                    leg = self.ticks(p.travel(r, p.job(a).location, p.job(b).location))
+                    m.add(self.start[b] >= self.end[a] + leg).only_enforce_if(arc)
+            m.add_circuit(arcs)
+
+    def _holding(self):
+        p, m = self.problem, self.model
+        for a, b, q in p.holding:
+            for r in self.robots:
+                in_a = sum(lit for (j, _, t, robot), lit in self.does.items()
+                           if j == a and t == q and robot == r)
+                in_b = sum(lit for (j, _, t, robot), lit in self.does.items()
+                           if j == b and t == q and robot == r)
+                if isinstance(in_a, int) and isinstance(in_b, int):
+                    continue
+                m.add(in_a == in_b)
+                if (a, b, r) in self.arcs:
+                    m.add(self.arcs[a, b, r] >= in_a)
+                else:
+                    m.add(in_a == 0)
+
+    def _panels(self):
+        """Cuts for identical panels: a robot's work plus its moves between panels fits in
+        the makespan, and mirrored solutions (panel k <-> N+1-k) are searched only once."""
+        p, m = self.problem, self.model
+        if len(p.panels) < 2 or p.fixed:
+            return
+        crossing_cost = {}
+        for robot in p.robots:
+            r = robot.name
+            visits = []
+            for k, names in enumerate(p.panels):
+                on = [self.on_job[j, r] for j in names if (j, r) in self.on_job]
+                visit = m.new_bool_var(f'visits_panel_{k + 1}_{r}')
+                m.add_max_equality(visit, on or [0])
+                visits.append(visit)
+            cost = min(p.travel(r, p.job(a).location, p.job(b).location)
+                       for k, first in enumerate(p.panels) for second in p.panels[k + 1:]
+                       for a in first for b in second)
+            crossing_cost[r] = cost
+            crossings = m.new_int_var(0, len(p.panels), f'panel_crossings_{r}')
+            m.add(crossings >= sum(visits) - 1)
+            work = sum(lit * self.ticks(p.duration(robot_name, q))
+                       for (_, _, q, robot_name), lit in self.does.items() if robot_name == r)
+            m.add(work + self.ticks(cost) * crossings + self.ticks(robot.release_time)
+                  <= self.makespan)
+        if any(r.start_location for r in p.robots):
+            return
+        slowest = max(crossing_cost, key=crossing_cost.get)
+        first, last = p.panels[0], p.panels[-1]
+        m.add(sum(self.on_job[j, slowest] for j in first if (j, slowest) in self.on_job)
+              >= sum(self.on_job[j, slowest] for j in last if (j, slowest) in self.on_job))
+
+    def add_hint(self, schedule: Schedule):
+        """Hint every part of `schedule` that names this problem's jobs and robots."""
+        m, p = self.model, self.problem
+        for name, a in schedule.jobs.items():
+            if name not in self.start or name in p.fixed:
+                continue
+            if a.plan >= len(p.job(name).plans):
+                continue
+            m.add_hint(self.start[name], self.ticks(a.start))
+            m.add_hint(self.end[name], self.ticks(a.end))
+            for index in range(len(p.job(name).plans)):
+                m.add_hint(self.plan[name, index], int(index == a.plan))
+            for (j, index, q, r), lit in self.does.items():
+                if j == name:
+                    m.add_hint(lit, int(index == a.plan and a.robots.get(r) == q))
+        for r, sequence in schedule.sequences.items():
+            if r not in self.route_nodes:
+                continue
+            route = [j for j in sequence if j in self.start]
+            for a, b in zip(route, route[1:], strict=False):
+                if (a, b, r) in self.arcs:
+                    m.add_hint(self.arcs[a, b, r], 1)
+
+    def read(self, solver) -> Schedule:
+        p = self.problem
+        jobs = {}
+        for job in p.jobs:
+            name = job.name
+            fixed = p.fixed.get(name)
+            if fixed is not None:
+                jobs[name] = JobAssignment(name, fixed.plan, fixed.start, fixed.end,
+                                           dict(fixed.robots))
+                continue
+            plan = next(i for i in range(len(job.plans)) if solver.value(self.plan[name, i]))
+            robots = {r: q for (j, index, q, r), lit in self.does.items()
+                      if j == name and index == plan and solver.value(lit)}
+            start = Fraction(solver.value(self.start[name]), self.scale)
+            end = start + max(p.duration(r, q) for r, q in robots.items())
+            jobs[name] = JobAssignment(name, plan, start, end, robots)
+        sequences = {}
+        for r in self.robots:
+            mine = [j for j in self.route_nodes[r] if r in jobs[j].robots]
+            successor = {a: b for (a, b, robot), arc in self.arcs.items()
+                         if robot == r and solver.value(arc)}
+            first = [j for j in mine if not any(successor.get(o) == j for o in mine)]
+            order = []
+            current = first[0] if first else None
+            while current is not None:
+                order.append(current)
+                current = successor.get(current)
+            sequences[r] = tuple(order)
+        return Schedule(jobs, sequences)

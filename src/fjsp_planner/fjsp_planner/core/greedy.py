@@ -1,0 +1,206 @@
+"""Greedy list scheduling: a valid schedule in milliseconds, for horizons, hints and fallback.
+
+Jobs are placed one at a time, each at the assignment (plan and robots) that completes it
+earliest. A holding arc (j, j', q) is placed as one block: j, then j' straight away with j's
+type-q robots, so no other job can come between them on the holders' routes.
+"""
+
+import itertools
+import random
+from fractions import Fraction
+
+from fjsp_planner.core.problem import Problem
+from fjsp_planner.core.schedule import JobAssignment, Schedule
+
+MAX_CANDIDATES_PER_PLAN = 2000
+
+
+class GreedyStuckError(RuntimeError):
+    """No job can be placed although some remain (e.g. held robots are needed elsewhere)."""
+
+
+def greedy_schedule(problem: Problem, passes: int = 16, seed: int = 0) -> Schedule:
+    """Best of several randomised passes; the first pass is deterministic."""
+    rng = random.Random(seed)
+    best, stuck = None, None
+    for attempt in range(passes):
+        try:
+            schedule = _one_pass(problem, rng if attempt else None)
+        except GreedyStuckError as error:
+            stuck = error
+            continue
+        if best is None or schedule.makespan < best.makespan:
+            best = schedule
+    if best is None:
+        raise stuck
+    return best
+
+
+def serial_upper_bound(problem: Problem) -> Fraction:
+    """Makespan of doing the jobs one after another, each with its slowest robots."""
+    robots = [r.name for r in problem.robots]
+    locations = problem.locations()
+    longest_leg = max((problem.travel(r, a, b) for r in robots for a in locations
+                       for b in locations), default=Fraction(0))
+    total = max([r.release_time for r in problem.robots]
+                + [f.end for f in problem.fixed.values()])
+    for job in problem.jobs:
+        if job.name in problem.fixed:
+            continue
+        slowest = max((problem.duration(r, q) for plan in job.plans for q in plan
+                       for r in robots if problem.duration(r, q) is not None),
+                      default=Fraction(0))
+        total += slowest + longest_leg
+    return total
+
+
+class _State:
+    def __init__(self, problem: Problem):
+        self.problem = problem
+        self.free = {r.name: r.release_time for r in problem.robots}
+        self.where = {r.name: r.start_location for r in problem.robots}
+        self.reserved = {}
+        self.jobs = {}
+        self.sequences = {r.name: [] for r in problem.robots}
+        self.holds_into = {a: (b, q) for a, b, q in problem.holding}
+        self.held_from = {b: (a, q) for a, b, q in problem.holding}
+        self.predecessors = {j.name: [] for j in problem.jobs}
+        for a, b in problem.precedence:
+            self.predecessors[b].append(a)
+
+    def copy(self):
+        other = _State.__new__(_State)
+        other.__dict__.update(self.__dict__)
+        for name in ('free', 'where', 'reserved', 'jobs'):
+            setattr(other, name, dict(getattr(self, name)))
+        other.sequences = {r: list(s) for r, s in self.sequences.items()}
+        return other
+
+    def arrival(self, robot, location):
+        here = self.where[robot]
+        leg = Fraction(0) if here is None else self.problem.travel(robot, here, location)
+        return self.free[robot] + leg
+
+    def place(self, name, plan, start, robots):
+        end = start + max(self.problem.duration(r, q) for r, q in robots.items())
+        self.commit(JobAssignment(name, plan, start, end, dict(robots)))
+
+    def commit(self, assignment):
+        self.jobs[assignment.job] = assignment
+        for r in assignment.robots:
+            self.free[r] = assignment.end
+            self.where[r] = self.problem.job(assignment.job).location
+            self.sequences[r].append(assignment.job)
+            if self.reserved.get(r) == assignment.job:
+                del self.reserved[r]
+        target = self.holds_into.get(assignment.job)
+        if target:
+            for r, q in assignment.robots.items():
+                if q == target[1]:
+                    self.reserved[r] = target[0]
+
+    def ready_at(self, name):
+        """When every predecessor is done, or None while one is still unplaced."""
+        ends = []
+        for a in self.predecessors[name]:
+            if a not in self.jobs:
+                return None
+            ends.append(self.jobs[a].end)
+        return max(ends, default=Fraction(0))
+
+    def candidates(self, name, ready, forced=None):
+        """(end, start, plan, robots) for every way to staff the job, best first."""
+        problem, job = self.problem, self.problem.job(name)
+        forced = forced or {}
+        out = []
+        for plan_index, plan in enumerate(job.plans):
+            remaining = list(plan)
+            for q in forced.values():
+                if q not in remaining:
+                    break
+                remaining.remove(q)
+            else:
+                free_robots = [r for r in self.free
+                               if r not in forced and self.reserved.get(r, name) == name]
+                count = 0
+                for chosen in itertools.permutations(free_robots, len(remaining)):
+                    robots = dict(forced)
+                    robots.update(zip(chosen, remaining, strict=True))
+                    if any(problem.duration(r, q) is None for r, q in robots.items()):
+                        continue
+                    start = max([ready] + [self.arrival(r, job.location) for r in robots])
+                    end = start + max(problem.duration(r, q) for r, q in robots.items())
+                    out.append((end, start, plan_index, robots))
+                    count += 1
+                    if count >= MAX_CANDIDATES_PER_PLAN:
+                        break
+        out.sort(key=lambda c: (c[0], c[1]))
+        return out
+
+
+def _one_pass(problem: Problem, rng) -> Schedule:
+    state = _State(problem)
+    for name, fixed in problem.fixed.items():
+        state.commit(JobAssignment(name, fixed.plan, fixed.start, fixed.end,
+                                   dict(fixed.robots)))
+    pending = [j.name for j in problem.jobs if j.name not in problem.fixed]
+    while pending:
+        options = []
+        for name in pending:
+            if name in state.held_from and state.held_from[name][0] not in state.jobs:
+                continue
+            block = _block_option(state, name)
+            if block is not None:
+                options.append(block)
+        if not options:
+            raise GreedyStuckError('greedy scheduling found no job it can place next among '
+                              + ', '.join(sorted(pending)))
+        options.sort(key=lambda o: o[0])
+        if rng is not None and len(options) > 1 and rng.random() < 0.3:
+            choice = options[rng.randrange(min(3, len(options)))]
+        else:
+            choice = options[0]
+        for name, plan, start, robots in choice[1]:
+            state.place(name, plan, start, robots)
+            pending.remove(name)
+    return Schedule(state.jobs, {r: tuple(s) for r, s in state.sequences.items()})
+
+
+def _block_option(state: _State, name):
+    """(score, [placements]) for the job and the jobs it holds into, or None if not ready."""
+    chain = [name]
+    while chain[-1] in state.holds_into:
+        chain.append(state.holds_into[chain[-1]][0])
+    for member in chain[1:]:
+        others = [a for a in state.predecessors[member] if a not in chain]
+        if any(a not in state.jobs for a in others):
+            return None
+    ready = state.ready_at(name)
+    if ready is None:
+        return None
+    forced = {}
+    if name in state.held_from:
+        _, q = state.held_from[name]
+        forced = {r: q for r, target in state.reserved.items() if target == name}
+    for end, start, plan, robots in state.candidates(name, ready, forced):
+        placements = _place_chain(state, chain, plan, start, robots)
+        if placements is not None:
+            return (end, placements)
+    return None
+
+
+def _place_chain(state: _State, chain, plan, start, robots):
+    """Try the chain's first job with this staffing and the rest greedily after it."""
+    trial = state.copy()
+    trial.place(chain[0], plan, start, robots)
+    placements = [(chain[0], plan, start, robots)]
+    for member in chain[1:]:
+        _, q = trial.held_from[member]
+        forced = {r: q for r, target in trial.reserved.items() if target == member}
+        options = trial.candidates(member, trial.ready_at(member), forced)
+        if not options:
+            return None
+        end, member_start, member_plan, member_robots = options[0]
+        trial.place(member, member_plan, member_start, member_robots)
+        placements.append((member, member_plan, member_start, member_robots))
+    return placements

@@ -1,0 +1,81 @@
+"""One entry point for every backend, returning the solver-neutral `Result`."""
+
+import time
+from fractions import Fraction
+
+from fjsp_planner.core.cpsat import solve_cpsat
+from fjsp_planner.core.greedy import GreedyStuckError, greedy_schedule
+from fjsp_planner.core.problem import Problem
+from fjsp_planner.core.schedule import Result, Schedule, Status
+
+SOLVERS = ('cpsat', 'greedy', 'mip')
+
+
+def solve(problem: Problem, solver: str = 'cpsat', time_limit: float = 10.0, workers: int = 2,
+          hint: Schedule | None = None, keep: Schedule | None = None,
+          mip_backend: str = 'SCIP', log: bool = False) -> Result:
+    """Minimise the makespan of `problem`.
+
+    `hint` warm-starts the search with whatever of it still fits the problem; `keep` (CP-SAT
+    only) then prefers, among schedules of the best makespan found, those that change the
+    fewest of its (job, robot) assignments. The greedy schedule bounds the horizon and is
+    returned when an exact solver finds nothing in time.
+    """
+    if solver not in SOLVERS:
+        raise ValueError(f"unknown solver '{solver}'; choose one of {', '.join(SOLVERS)}")
+    began = time.monotonic()
+    try:
+        greedy = greedy_schedule(problem)
+    except GreedyStuckError:
+        greedy = None
+    if solver == 'greedy':
+        if greedy is None:
+            return Result(Status.UNKNOWN, None, None, time.monotonic() - began, None, 'greedy',
+                          notes=('greedy scheduling got stuck; try an exact solver',))
+        elapsed = time.monotonic() - began
+        return Result(Status.FEASIBLE, greedy.makespan, critical_path_bound(problem), elapsed,
+                      greedy, 'greedy', first_solution_seconds=elapsed)
+    remaining = max(0.05, time_limit - (time.monotonic() - began))
+    if solver == 'mip':
+        from fjsp_planner.core.mip import solve_mip
+
+        result = solve_mip(problem, remaining, backend=mip_backend, workers=workers,
+                           hint=hint or greedy, log=log)
+    else:
+        result = solve_cpsat(problem, remaining, workers, hint=hint, keep=keep,
+                             upper_bound=greedy, log=log)
+    if result.schedule is None and greedy is not None and result.status != Status.INFEASIBLE:
+        return Result(Status.FEASIBLE, greedy.makespan, critical_path_bound(problem),
+                      time.monotonic() - began, greedy, 'greedy',
+                      notes=result.notes + (f'{result.solver} found no schedule in '
+                                            f'{time_limit:g} s; greedy schedule returned',))
+    return result
+
+
+def critical_path_bound(problem: Problem) -> Fraction:
+    """Longest precedence chain, each job at its fastest possible duration."""
+    fastest = {}
+    for job in problem.jobs:
+        fixed = problem.fixed.get(job.name)
+        if fixed is not None:
+            fastest[job.name] = fixed.end - fixed.start
+            continue
+        per_plan = []
+        for plan in job.plans:
+            times = [min((t for r in problem.robots
+                          if (t := problem.duration(r.name, q)) is not None),
+                         default=Fraction(0)) for q in plan]
+            per_plan.append(max(times))
+        fastest[job.name] = min(per_plan)
+    starts = {job.name: Fraction(0) for job in problem.jobs}
+    for name, fixed in problem.fixed.items():
+        starts[name] = fixed.start
+    ends = {}
+
+    def end(name):
+        if name not in ends:
+            ready = max((end(a) for a in problem.predecessors(name)), default=starts[name])
+            ends[name] = max(ready, starts[name]) + fastest[name]
+        return ends[name]
+
+    return max((end(j.name) for j in problem.jobs), default=Fraction(0))
