@@ -25,10 +25,13 @@ from fjsp_planner.core.replan import (
     ExecutionState,
     RobotState,
     StateError,
+    replan,
     residual_problem,
     simulated_state,
 )
+from fjsp_planner.core.scenario import load_scenario
 from fjsp_planner.core.schedule import JobAssignment, Schedule
+from fjsp_planner.core.solve import solve
 from fjsp_planner.core.validate import validate
 
 SCENARIO = Path(__file__).resolve().parents[2] / 'config' / 'scenarios' / 'solar_panel.yaml'
@@ -185,6 +188,114 @@ def test_everything_done_is_complete(small):
 def test_kept_jig_job_needs_the_executed_schedule(small):
     with pytest.raises(ValueError, match="job 'J' is done and holds for 'W'"):
         residual_problem(small, at(small, Fraction(5, 2), {'C'}))
+
+
+def check_replan(problem, previous, state, **limits):
+    """Re-plan, and check what every re-plan must satisfy whatever the solver's choices."""
+    result = replan(problem, previous, state, **limits)
+    assert result.problems == []
+    schedule = result.schedule
+    failed = {name for name, r in state.robots.items() if not r.healthy}
+    assert not failed & set().union(*(a.robots for a in schedule.jobs.values()))
+    assert all(not schedule.sequences.get(name) for name in failed)
+    # Finished jobs are not redone; a kept jig job stays exactly as it was posed.
+    redone = state.done & set(schedule.jobs)
+    assert redone == set(result.residual.kept) | set(result.residual.voided)
+    for name in result.residual.kept:
+        fixed = result.residual.problem.fixed[name]
+        assert (schedule.jobs[name].start, schedule.jobs[name].end) == (fixed.start, fixed.end)
+    assert all(a.start >= state.now for name, a in schedule.jobs.items()
+               if name not in result.residual.problem.fixed)
+    return result
+
+
+# (now, failed robots, hand-computed optimum of what remains, why)
+HAND_CHECKED = [
+    (1, {'C'}, 13, 'travelling: W [3, 6] by A and B, then one of them travels to q in 4, F 3'),
+    (1, {'B'}, 21, 'working: A must hold from J into W, so C comes back (8) for P [8, 11], '
+                   'W [11, 14], travels (18), F [18, 21]'),
+    (Fraction(5, 2), {'A'}, 18, 'holding: B redoes J [3, 5] after P, C comes back (8) for W '
+                                '[8, 11], travels (15), F [15, 18]'),
+    (Fraction(5, 2), {'C'}, 13, 'a healthy holder: A goes on to W [3, 6] with B, then as '
+                                'when travelling'),
+    (4, {'B'}, 18, 'W aborted: A still holds, C comes back (8) for W [8, 11], F [15, 18]'),
+    (7, {'A'}, 9, "after A's last job: F goes on as planned"),
+]
+
+
+@pytest.mark.parametrize(('now', 'failed', 'makespan', 'why'), HAND_CHECKED,
+                         ids=[row[3].split(':')[0] for row in HAND_CHECKED])
+def test_replan_finds_the_hand_computed_makespan(small, now, failed, makespan, why):
+    result = check_replan(small, PLAN, at(small, now, failed), time_limit=5.0)
+    assert result.result.makespan == makespan
+
+
+def test_replan_sends_a_kept_holder_directly_to_the_held_job(small):
+    result = check_replan(small, PLAN, at(small, Fraction(5, 2), {'C'}), time_limit=5.0)
+    assert result.schedule.sequences['A'][:2] == ('J', 'W')
+    assert result.schedule.jobs['W'].robots['A'] == 0
+
+
+def test_replan_after_recovery(small):
+    """B back at p at 5 with C at q: B does P [5, 8] and J [8, 10], holds in W [10, 13]
+    with C (at p since 9); one travels (17), F [17, 20]."""
+    state = at(small, 1, {'A', 'B'})
+    assert replan(small, PLAN, state).residual.blocked
+    later = ExecutionState(Fraction(5), state.done, {}, {
+        **state.robots,
+        'B': RobotState('B', True, 'p', Fraction(5)),
+        'C': RobotState('C', True, 'q', Fraction(5))})
+    assert check_replan(small, PLAN, later, time_limit=5.0).result.makespan == 20
+
+
+def test_replan_when_everything_is_done(small):
+    result = replan(small, PLAN, at(small, 10))
+    assert result.residual.complete and result.result is None and result.schedule is None
+
+
+@pytest.fixture(scope='module')
+def paper():
+    problem = load_scenario(SCENARIO)
+    result = solve(problem, time_limit=30.0)
+    assert result.makespan == 32
+    return problem, result.schedule
+
+
+def test_paper_failure_after_a_robots_last_job_keeps_the_optimum(paper):
+    """The rest of the optimal plan still works without that robot, and nothing shorter
+    exists: with the part already executed it would beat the optimum 32."""
+    problem, plan = paper
+    last = {r: plan.jobs[seq[-1]].end for r, seq in plan.sequences.items() if seq}
+    robot = min(last, key=last.get)
+    now = last[robot] + Fraction(1, 2)
+    assert now < 32
+    result = check_replan(problem, plan, simulated_state(problem, plan, now, {robot}))
+    assert result.result.makespan == 32
+
+
+@pytest.mark.parametrize(('now', 'robot'), [
+    (Fraction(1, 2), 'Assembler'), (3, 'MARC1'), (9, 'MARC2'), (Fraction(29, 2), 'LSMS'),
+    (20, 'Assembler'), (Fraction(243, 10), 'MARC1'), (28, 'MARC1')])
+def test_paper_single_failures_give_valid_replans(paper, now, robot):
+    """Whatever the plan, its executed part plus the re-plan is a schedule of the paper's
+    instance, so it cannot beat 32."""
+    problem, plan = paper
+    state = simulated_state(problem, plan, Fraction(now), {robot})
+    result = check_replan(problem, plan, state)
+    assert result.result.makespan >= 32
+
+
+def test_paper_two_failures_block_then_recovery_unblocks(paper):
+    problem, plan = paper
+    state = simulated_state(problem, plan, Fraction(1), {'MARC1', 'MARC2'})
+    result = replan(problem, plan, state)
+    assert result.result is None
+    assert result.residual.blocked == [
+        f"job '{job}' cannot be staffed: plan 0 [0, 0, 2] needs 3 distinct robots able to "
+        'do [0, 0, 2]; 2 healthy can (failed: MARC1, MARC2)' for job in ('Aa', 'Ab')]
+    marc1 = state.robots['MARC1']
+    back = replace(state, robots={**state.robots, 'MARC1': replace(marc1, healthy=True)})
+    check_replan(problem, plan, back)
 
 
 def _with_robot(state, robot_state):

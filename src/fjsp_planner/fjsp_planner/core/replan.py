@@ -25,7 +25,9 @@ from dataclasses import dataclass, field, replace
 from fractions import Fraction
 
 from fjsp_planner.core.problem import FixedJob, Job, Problem, Robot, max_staffed
-from fjsp_planner.core.schedule import JobAssignment, Schedule
+from fjsp_planner.core.schedule import JobAssignment, Result, Schedule
+from fjsp_planner.core.solve import solve
+from fjsp_planner.core.validate import validate
 
 
 class StateError(ValueError):
@@ -76,6 +78,36 @@ class Residual:
     def complete(self) -> bool:
         """Every job is done: there is nothing left to plan."""
         return self.problem is None and not self.blocked
+
+
+@dataclass(frozen=True)
+class Replan:
+    residual: Residual
+    result: Result | None
+    """None when there was nothing to solve: everything is done, or something is blocked."""
+    problems: list[str]
+    """What `validate` finds wrong with the result's schedule; empty when it is valid."""
+
+    @property
+    def schedule(self) -> Schedule | None:
+        """The new plan of what remains, with its running and kept jobs fixed."""
+        return self.result.schedule if self.result is not None else None
+
+
+def replan(problem: Problem, previous: Schedule, state: ExecutionState, time_limit=1.0,
+           workers=2) -> Replan:
+    """Re-plan what remains of `problem` in `state`, `previous` being the schedule executed.
+
+    The search starts from what still fits of `previous` and, among the shortest schedules
+    it finds, prefers the one moving the fewest robots off their previous jobs.
+    """
+    residual = residual_problem(problem, state, previous)
+    if residual.problem is None:
+        return Replan(residual, None, [])
+    result = solve(residual.problem, time_limit=time_limit, workers=workers, hint=previous,
+                   keep=previous)
+    problems = [] if result.schedule is None else validate(residual.problem, result.schedule)
+    return Replan(residual, result, problems)
 
 
 def residual_problem(problem: Problem, state: ExecutionState,
