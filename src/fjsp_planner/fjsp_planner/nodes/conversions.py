@@ -1,0 +1,70 @@
+"""Between the domain core's objects and fjsp_msgs messages."""
+
+import math
+
+from fjsp_msgs.msg import JobState, Plan, PlanTask, RobotPlan, TaskEvent
+from fjsp_planner.core.problem import Problem
+from fjsp_planner.core.schedule import Result, Schedule
+from fjsp_planner.core.tracking import EventKind, MissionTracker
+
+EVENT_KINDS = {
+    TaskEvent.KIND_ARRIVED: EventKind.ARRIVED,
+    TaskEvent.KIND_STARTED: EventKind.STARTED,
+    TaskEvent.KIND_OPERATION_DONE: EventKind.OPERATION_DONE,
+    TaskEvent.KIND_ABORTED: EventKind.ABORTED,
+}
+MODE_NAMES = ('idle', 'travelling', 'waiting', 'working', 'holding', 'failed', 'offline')
+"""RobotState.MODE_* values, in order, as the core names them."""
+
+
+def _float(value) -> float:
+    return math.nan if value is None else float(value)
+
+
+def plan_msg(problem: Problem, schedule: Schedule, result: Result, revision: int,
+             mission_start, time_scale: float, stamp) -> Plan:
+    """The plan message of a schedule: every robot's tasks with travel, times and partners."""
+    holds = {(a, q): b for a, b, q in problem.holding}
+    robots = []
+    for robot in problem.robots:
+        sequence = schedule.sequences.get(robot.name, ())
+        tasks = []
+        for index, visit in enumerate(schedule.visits(problem, robot.name)):
+            a = schedule.jobs[visit.job]
+            q = a.robots[robot.name]
+            following = sequence[index + 1] if index + 1 < len(sequence) else None
+            tasks.append(PlanTask(
+                job=visit.job, process_plan=a.plan, operation_type=q,
+                operation_name=problem.operation_types[q],
+                location=problem.job(visit.job).location,
+                travel_start=float(visit.travel_start), arrival=float(visit.arrival),
+                start=float(a.start),
+                operation_end=float(a.start + problem.duration(robot.name, q)),
+                end=float(a.end),
+                co_workers=sorted(r for r in a.robots if r != robot.name),
+                predecessors=problem.predecessors(visit.job),
+                held_into_next=following is not None
+                and holds.get((visit.job, q)) == following))
+        robots.append(RobotPlan(robot=robot.name, robot_type=robot.type, tasks=tasks))
+    return Plan(stamp=stamp, revision=revision, scenario_id=problem.name,
+                mission_start=mission_start, time_scale=time_scale,
+                makespan=float(result.makespan), solver_status=str(result.status),
+                lower_bound=_float(result.lower_bound), robots=robots)
+
+
+def job_states(tracker: MissionTracker) -> list[JobState]:
+    states = []
+    for name, record in tracker.jobs.items():
+        planned = tracker.plan.jobs.get(name) if tracker.plan is not None else None
+        if record.end is not None:
+            state = JobState.STATE_DONE
+        elif record.started:
+            state = JobState.STATE_RUNNING
+        else:
+            state = JobState.STATE_PENDING
+        states.append(JobState(
+            job=name, state=state, robots=sorted(planned.robots) if planned else [],
+            planned_start=_float(planned.start if planned else None),
+            planned_end=_float(planned.end if planned else None),
+            actual_start=_float(record.start), actual_end=_float(record.end)))
+    return states

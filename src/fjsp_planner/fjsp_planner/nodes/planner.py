@@ -1,0 +1,299 @@
+"""The planner node: waits for the fleet, solves the scenario, publishes the plan latched and
+tracks its execution from the robots' task events (see docs/ros-interfaces.md)."""
+
+import math
+import sys
+from concurrent.futures import Future, ThreadPoolExecutor
+from pathlib import Path
+
+import rclpy
+from ament_index_python.packages import PackageNotFoundError, get_package_share_directory
+from rclpy.duration import Duration
+from rclpy.exceptions import InvalidParameterTypeException
+from rclpy.executors import ExternalShutdownException
+from rclpy.node import Node
+from rclpy.time import Time
+
+from fjsp_msgs.msg import JobStates, MissionStatus, Plan, RobotState, TaskEvent
+from fjsp_planner.core.problem import Problem, ProblemError
+from fjsp_planner.core.scenario import load_scenario
+from fjsp_planner.core.schedule import Result
+from fjsp_planner.core.solve import solve
+from fjsp_planner.core.tracking import Ignored, MissionTracker
+from fjsp_planner.core.validate import validate
+from fjsp_planner.nodes.conversions import EVENT_KINDS, MODE_NAMES, job_states, plan_msg
+from fjsp_planner.nodes.interfaces import (
+    EVENTS_QOS,
+    JOB_STATES_TOPIC,
+    LATCHED_QOS,
+    MISSION_STATUS_TOPIC,
+    PLAN_TOPIC,
+    ROBOT_STATES_TOPIC,
+    TASK_EVENTS_TOPIC,
+)
+
+
+class ParameterError(ValueError):
+    """A node parameter with a value the node cannot run with."""
+
+
+def default_scenario() -> str:
+    try:
+        share = get_package_share_directory('fjsp_planner')
+    except PackageNotFoundError:
+        raise ParameterError("parameter 'scenario' not given and package 'fjsp_planner' "
+                             'is not installed; pass -p scenario:=<path>') from None
+    return str(Path(share) / 'scenarios' / 'solar_panel.yaml')
+
+
+class PlannerNode(Node):
+    def __init__(self):
+        super().__init__('planner')
+        scenario = self.parameter('scenario', '') or default_scenario()
+        panels = self.parameter('panels', 0)
+        shift = self.parameter('shift', -1.0)
+        self.solver = self.parameter('solver', 'cpsat')
+        self.time_limit = self.parameter('time_limit', 10.0)
+        self.workers = self.parameter('workers', 2)
+        self.time_scale = self.parameter('time_scale', 0.05)
+        self.robot_wait_timeout = self.parameter('robot_wait_timeout', 15.0)
+        self.start_delay = self.parameter('start_delay', 0.5)
+        status_period = self.parameter('status_period', 0.5)
+        for name, value, low in (('panels', panels, 0), ('time_limit', self.time_limit, 1e-9),
+                                 ('workers', self.workers, 1),
+                                 ('time_scale', self.time_scale, 1e-9),
+                                 ('robot_wait_timeout', self.robot_wait_timeout, 0),
+                                 ('start_delay', self.start_delay, 0),
+                                 ('status_period', status_period, 1e-9)):
+            if not value >= low:
+                raise ParameterError(f"parameter '{name}' must be >= {low:g}, got {value}")
+        try:
+            self.problem: Problem = load_scenario(scenario, panels=panels or None,
+                                                  shift=shift if shift >= 0 else None)
+        except ProblemError as error:
+            raise ParameterError(f"parameter 'scenario': cannot use '{scenario}':\n"
+                                 + '\n'.join(error.problems)) from None
+        log = self.get_logger()
+        log.info(f"scenario '{self.problem.name}' from {scenario}: "
+                 f'{len(self.problem.jobs)} jobs, robots '
+                 + ', '.join(r.name for r in self.problem.robots))
+
+        self.tracker = MissionTracker(self.problem)
+        self.state = MissionStatus.STATE_WAITING_FOR_ROBOTS
+        self.blocked: list[str] = []
+        self.plan: Plan | None = None
+        self.mission_start: Time | None = None
+        self.job_done_ids: set[str] = set()
+        self.solving: Future | None = None
+        # One worker thread: the solve runs there so the executor keeps serving callbacks.
+        self.pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix='solver')
+        self.waiting_since = self.get_clock().now()
+
+        self.plan_pub = self.create_publisher(Plan, PLAN_TOPIC, LATCHED_QOS)
+        self.status_pub = self.create_publisher(MissionStatus, MISSION_STATUS_TOPIC, LATCHED_QOS)
+        self.jobs_pub = self.create_publisher(JobStates, JOB_STATES_TOPIC, LATCHED_QOS)
+        self.event_pub = self.create_publisher(TaskEvent, TASK_EVENTS_TOPIC, EVENTS_QOS)
+        self.create_subscription(RobotState, ROBOT_STATES_TOPIC, self.on_robot_state,
+                                 LATCHED_QOS)
+        self.create_subscription(TaskEvent, TASK_EVENTS_TOPIC, self.on_event, EVENTS_QOS)
+        self.create_subscription(Plan, PLAN_TOPIC, self.on_plan, LATCHED_QOS)
+        self.create_timer(0.1, self.tick)
+        self.create_timer(status_period, self.publish_periodic)
+        self.publish_status()
+
+    def parameter(self, name, default):
+        try:
+            return self.declare_parameter(name, default).value
+        except InvalidParameterTypeException as e:
+            raise ParameterError(f"parameter '{name}' must be a {type(default).__name__} "
+                                 f'like {default!r}: {e}') from None
+
+    # --- time ------------------------------------------------------------------------
+
+    def now_units(self) -> float:
+        """Schedule time since the mission start (negative before it, 0 without a plan)."""
+        if self.mission_start is None:
+            return 0.0
+        elapsed = (self.get_clock().now() - self.mission_start).nanoseconds * 1e-9
+        return elapsed / self.time_scale
+
+    # --- planning --------------------------------------------------------------------
+
+    def tick(self) -> None:
+        if self.state == MissionStatus.STATE_WAITING_FOR_ROBOTS:
+            missing = self.tracker.missing_robots
+            waited = (self.get_clock().now() - self.waiting_since).nanoseconds * 1e-9
+            if missing and waited < self.robot_wait_timeout:
+                return
+            if missing:
+                self.get_logger().warning(
+                    f'planning without a report from {", ".join(missing)} after waiting '
+                    f'{self.robot_wait_timeout:g} s; they get the plan when they join')
+            self.start_solve()
+        elif self.solving is not None and self.solving.done():
+            future, self.solving = self.solving, None
+            self.finish_solve(future)
+
+    def start_solve(self) -> None:
+        self.state = MissionStatus.STATE_PLANNING
+        self.get_logger().info(f'solving with {self.solver}, time limit {self.time_limit:g} s, '
+                               f'{self.workers} workers')
+        self.solving = self.pool.submit(solve, self.problem, solver=self.solver,
+                                        time_limit=self.time_limit, workers=self.workers)
+        self.publish_status()
+
+    def finish_solve(self, future: Future) -> None:
+        log = self.get_logger()
+        try:
+            result: Result = future.result()
+        except ValueError as error:
+            self.fail([f'solver: {error}'])
+            return
+        if result.schedule is None:
+            self.fail([f"no plan: solver '{result.solver}' answered {result.status} "
+                       f'within {self.time_limit:g} s'])
+            return
+        problems = validate(self.problem, result.schedule)
+        if problems:
+            self.fail([f'solver returned an invalid schedule: {p}' for p in problems])
+            return
+        revision = self.tracker.revision + 1
+        self.tracker.set_plan(result.schedule, revision)
+        now = self.get_clock().now()
+        self.mission_start = now + Duration(nanoseconds=int(self.start_delay * 1e9))
+        self.plan = plan_msg(self.problem, result.schedule, result, revision,
+                             self.mission_start.to_msg(), self.time_scale, now.to_msg())
+        self.plan_pub.publish(self.plan)
+        self.state = MissionStatus.STATE_EXECUTING
+        gap = f', gap {result.gap:.1%}' if result.gap is not None else ''
+        log.info(f'published plan revision {revision}: makespan {float(result.makespan):g} '
+                 f'({result.status}{gap}, {result.solve_seconds:.2f} s); mission starts in '
+                 f'{self.start_delay:g} s at {self.time_scale:g} s per unit')
+        for robot_plan in self.plan.robots:
+            log.info(f'  {robot_plan.robot}: '
+                     + (' -> '.join(t.job for t in robot_plan.tasks) or 'no task'))
+        self.publish_jobs()
+        self.publish_status()
+
+    def fail(self, reasons: list[str]) -> None:
+        self.state = MissionStatus.STATE_FAILED
+        self.blocked = reasons
+        for reason in reasons:
+            self.get_logger().error(reason)
+        self.publish_status()
+
+    # --- reports ---------------------------------------------------------------------
+
+    def ignored(self, outcome, what: str) -> None:
+        self.get_logger().warning(f'ignoring {outcome.ignored} {what}: {outcome.reason}')
+        self.publish_status()
+
+    def on_robot_state(self, msg: RobotState) -> None:
+        mode = MODE_NAMES[msg.mode] if msg.mode < len(MODE_NAMES) else f'mode {msg.mode}'
+        outcome = self.tracker.record_robot_state(msg.robot, mode, msg.location,
+                                                  msg.destination, msg.busy_until)
+        if outcome.ignored:
+            self.ignored(outcome, 'robot state')
+
+    def on_event(self, msg: TaskEvent) -> None:
+        if msg.kind == TaskEvent.KIND_JOB_DONE:
+            if msg.event_id not in self.job_done_ids:
+                self.tracker.ignored[Ignored.UNKNOWN] += 1
+                self.get_logger().warning(f"ignoring unknown job-done event '{msg.event_id}':"
+                                          ' only the planner declares jobs done')
+                self.publish_status()
+            return
+        if msg.kind not in EVENT_KINDS:
+            self.tracker.ignored[Ignored.UNKNOWN] += 1
+            self.get_logger().warning(f"ignoring unknown event '{msg.event_id}': kind "
+                                      f'{msg.kind} is not a TaskEvent kind')
+            self.publish_status()
+            return
+        outcome = self.tracker.record_event(msg.event_id, EVENT_KINDS[msg.kind], msg.robot,
+                                            msg.job, msg.plan_revision, msg.time)
+        if outcome.ignored:
+            self.ignored(outcome, 'event')
+            return
+        if outcome.job_done is not None:
+            job, end = outcome.job_done
+            event_id = f'planner/{job}/job_done/{self.tracker.revision}'
+            self.job_done_ids.add(event_id)
+            self.event_pub.publish(TaskEvent(
+                stamp=self.get_clock().now().to_msg(), event_id=event_id,
+                kind=TaskEvent.KIND_JOB_DONE, job=job, plan_revision=self.tracker.revision,
+                time=end))
+            done = len(self.tracker.done)
+            self.get_logger().info(f'job {job} done at t={end:.2f} ({done}/'
+                                   f'{len(self.tracker.jobs)})')
+            if self.tracker.complete:
+                self.state = MissionStatus.STATE_COMPLETE
+                self.get_logger().info(
+                    f'mission complete: executed makespan '
+                    f'{float(self.tracker.projected_makespan(0)):.2f}, planned '
+                    f'{self.plan.makespan:g}')
+        self.publish_jobs()
+        self.publish_status()
+
+    def on_plan(self, msg: Plan) -> None:
+        if self.plan is not None and msg.revision == self.plan.revision \
+                and msg.stamp == self.plan.stamp:
+            return
+        current = self.tracker.revision
+        kind = Ignored.STALE if msg.revision <= current else Ignored.UNKNOWN
+        self.tracker.ignored[kind] += 1
+        self.get_logger().warning(f'ignoring {kind} plan revision {msg.revision} from another '
+                                  f'publisher: this planner owns the plan (revision {current})')
+        self.publish_status()
+
+    # --- publishing ------------------------------------------------------------------
+
+    def publish_periodic(self) -> None:
+        self.publish_status()
+        if self.tracker.plan is not None:
+            self.publish_jobs()
+
+    def publish_jobs(self) -> None:
+        self.jobs_pub.publish(JobStates(stamp=self.get_clock().now().to_msg(),
+                                        plan_revision=self.tracker.revision,
+                                        jobs=job_states(self.tracker)))
+
+    def publish_status(self) -> None:
+        tracker = self.tracker
+        now = self.now_units()
+        planned = self.plan.makespan if self.plan is not None else math.nan
+        projected = float(tracker.projected_makespan(now)) if tracker.plan else math.nan
+        blocked = list(self.blocked)
+        if self.state == MissionStatus.STATE_WAITING_FOR_ROBOTS:
+            blocked = [f"waiting for robot '{r}' to report" for r in tracker.missing_robots]
+        self.status_pub.publish(MissionStatus(
+            stamp=self.get_clock().now().to_msg(), state=self.state,
+            plan_revision=tracker.revision, scenario_id=self.problem.name,
+            jobs_done=len(tracker.done), jobs_running=len(tracker.running),
+            jobs_total=len(tracker.jobs), planned_makespan=planned,
+            projected_makespan=projected, elapsed=max(now, 0.0), blocked_reasons=blocked,
+            ignored_stale=tracker.ignored[Ignored.STALE],
+            ignored_duplicate=tracker.ignored[Ignored.DUPLICATE],
+            ignored_unknown=tracker.ignored[Ignored.UNKNOWN]))
+
+    def destroy_node(self):
+        self.pool.shutdown(wait=False, cancel_futures=True)
+        return super().destroy_node()
+
+
+def main(args=None):
+    rclpy.init(args=args)
+    node = None
+    code = 0
+    try:
+        node = PlannerNode()
+        rclpy.spin(node)
+    except ParameterError as e:
+        rclpy.logging.get_logger('planner').error(str(e))
+        code = 2
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown()
+    sys.exit(code)

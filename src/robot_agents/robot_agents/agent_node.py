@@ -1,0 +1,211 @@
+"""A mock robot: follows its task sequence of the latest plan in simulated time.
+
+One process per robot (`robot_name` parameter); the three executables differ only in the robot
+type they accept, so a plan that gives MARC1 to an assembler_agent is refused, not executed.
+"""
+
+import sys
+
+import rclpy
+from rclpy.exceptions import InvalidParameterTypeException
+from rclpy.executors import ExternalShutdownException
+from rclpy.node import Node
+from rclpy.time import Time as RosTime
+
+from fjsp_msgs.msg import Plan, RobotState, TaskEvent
+from fjsp_planner.nodes.interfaces import (
+    EVENTS_QOS,
+    LATCHED_QOS,
+    PLAN_TOPIC,
+    ROBOT_STATES_TOPIC,
+    TASK_EVENTS_TOPIC,
+)
+from robot_agents.execution import EventKind, Mode, RobotExecution, Task
+
+MODE_TO_MSG = {
+    Mode.IDLE: RobotState.MODE_IDLE,
+    Mode.TRAVELLING: RobotState.MODE_TRAVELLING,
+    Mode.WAITING: RobotState.MODE_WAITING,
+    Mode.WORKING: RobotState.MODE_WORKING,
+    Mode.HOLDING: RobotState.MODE_HOLDING,
+}
+KIND_TO_MSG = {
+    EventKind.ARRIVED: TaskEvent.KIND_ARRIVED,
+    EventKind.STARTED: TaskEvent.KIND_STARTED,
+    EventKind.OPERATION_DONE: TaskEvent.KIND_OPERATION_DONE,
+    EventKind.ABORTED: TaskEvent.KIND_ABORTED,
+}
+
+
+class ParameterError(ValueError):
+    """A node parameter with a value the node cannot run with."""
+
+
+class RobotAgent(Node):
+    def __init__(self, robot_type: str):
+        super().__init__(f'{robot_type.lower()}_agent')
+        self.robot_type = robot_type
+        self.robot = self.parameter('robot_name', '')
+        self.time_scale = self.parameter('time_scale', 0.0)
+        tick_period = self.parameter('tick_period', 0.01)
+        heartbeat_period = self.parameter('heartbeat_period', 0.2)
+        if not self.robot:
+            raise ParameterError("parameter 'robot_name' is required "
+                                 '(e.g. --ros-args -p robot_name:=MARC1)')
+        if not self.time_scale >= 0:
+            raise ParameterError(f"parameter 'time_scale' must be >= 0 (0: the plan's), "
+                                 f'got {self.time_scale}')
+        for name, value in (('tick_period', tick_period),
+                            ('heartbeat_period', heartbeat_period)):
+            if not value > 0:
+                raise ParameterError(f"parameter '{name}' must be > 0 seconds, got {value}")
+
+        self.execution = RobotExecution(self.robot)
+        self.mission_start: RosTime | None = None
+        self.scale = self.time_scale
+        self.last_state = None
+
+        self.state_pub = self.create_publisher(RobotState, ROBOT_STATES_TOPIC, LATCHED_QOS)
+        self.event_pub = self.create_publisher(TaskEvent, TASK_EVENTS_TOPIC, EVENTS_QOS)
+        self.create_subscription(Plan, PLAN_TOPIC, self.on_plan, LATCHED_QOS)
+        self.create_subscription(TaskEvent, TASK_EVENTS_TOPIC, self.on_event, EVENTS_QOS)
+        self.create_timer(tick_period, self.tick)
+        self.create_timer(heartbeat_period, self.publish_state)
+        self.publish_state()
+        self.get_logger().info(f"robot '{self.robot}' ({robot_type}) ready, waiting for a plan")
+
+    def parameter(self, name, default):
+        try:
+            return self.declare_parameter(name, default).value
+        except InvalidParameterTypeException as e:
+            raise ParameterError(f"parameter '{name}' must be a {type(default).__name__} "
+                                 f'like {default!r}: {e}') from None
+
+    def now_units(self) -> float | None:
+        """Schedule time since the mission start, or None before the first plan."""
+        if self.mission_start is None:
+            return None
+        elapsed = (self.get_clock().now() - self.mission_start).nanoseconds * 1e-9
+        return elapsed / self.scale
+
+    def on_plan(self, msg: Plan) -> None:
+        log = self.get_logger()
+        if msg.revision <= self.execution.revision:
+            if msg.revision < self.execution.revision:
+                log.warning(f'ignoring stale plan revision {msg.revision}: following '
+                            f'revision {self.execution.revision}')
+            return
+        mine = [r for r in msg.robots if r.robot == self.robot]
+        if not mine:
+            log.warning(f"plan revision {msg.revision} has no robot '{self.robot}'; "
+                        'staying idle')
+            return
+        if mine[0].robot_type != self.robot_type:
+            log.error(f"plan revision {msg.revision} makes '{self.robot}' a "
+                      f"'{mine[0].robot_type}' but this agent is a '{self.robot_type}'; "
+                      'ignoring the plan')
+            return
+        if not msg.time_scale > 0:
+            log.error(f'plan revision {msg.revision} has time_scale {msg.time_scale}; '
+                      'ignoring the plan')
+            return
+        if self.time_scale and self.time_scale != msg.time_scale:
+            log.warning(f'running at time_scale {self.time_scale} s/unit while the plan '
+                        f'assumes {msg.time_scale}: this robot runs off the planned pace')
+        self.scale = self.time_scale or msg.time_scale
+        self.mission_start = RosTime.from_msg(msg.mission_start)
+        job_robots = {}
+        for robot_plan in msg.robots:
+            for t in robot_plan.tasks:
+                job_robots.setdefault(t.job, set()).add(robot_plan.robot)
+        tasks = [Task(job=t.job, operation_type=t.operation_type, location=t.location,
+                      travel_start=t.travel_start, arrival=t.arrival, start=t.start,
+                      operation_end=t.operation_end, end=t.end,
+                      co_workers=tuple(t.co_workers), predecessors=tuple(t.predecessors),
+                      held_into_next=t.held_into_next)
+                 for t in mine[0].tasks]
+        now = max(self.now_units(), 0.0)
+        events = self.execution.set_plan(msg.revision, tasks, job_robots, now)
+        log.info(f'following plan revision {msg.revision}: '
+                 + (' -> '.join(t.job for t in tasks) or 'no task'))
+        self.publish_events(events)
+        self.tick()
+
+    def on_event(self, msg: TaskEvent) -> None:
+        if msg.robot == self.robot and msg.kind != TaskEvent.KIND_JOB_DONE:
+            return
+        if msg.kind == TaskEvent.KIND_ARRIVED:
+            self.execution.arrived(msg.robot, msg.job, msg.time)
+        elif msg.kind == TaskEvent.KIND_OPERATION_DONE:
+            self.execution.operation_done(msg.robot, msg.job, msg.time)
+        elif msg.kind == TaskEvent.KIND_JOB_DONE:
+            self.execution.job_done(msg.job, msg.time)
+        elif msg.kind == TaskEvent.KIND_ABORTED:
+            self.execution.aborted(msg.job)
+        self.tick()
+
+    def tick(self) -> None:
+        now = self.now_units()
+        if now is None or now < 0:
+            return
+        self.publish_events(self.execution.step(now))
+        state = (self.execution.mode, self.execution.current_job, self.execution.location,
+                 self.execution.revision)
+        if state != self.last_state:
+            self.publish_state()
+
+    def publish_events(self, events) -> None:
+        for e in events:
+            kind = e.kind.value
+            self.event_pub.publish(TaskEvent(
+                stamp=self.get_clock().now().to_msg(),
+                event_id=f'{self.robot}/{e.job}/{kind}/{e.attempt}',
+                kind=KIND_TO_MSG[e.kind], robot=self.robot, job=e.job,
+                plan_revision=self.execution.revision, time=e.time, reason=e.reason))
+            self.get_logger().info(f'{kind} {e.job} at t={e.time:.2f}'
+                                   + (f' ({e.reason})' if e.reason else ''))
+
+    def publish_state(self) -> None:
+        now = self.now_units()
+        execution = self.execution
+        self.last_state = (execution.mode, execution.current_job, execution.location,
+                           execution.revision)
+        self.state_pub.publish(RobotState(
+            stamp=self.get_clock().now().to_msg(), robot=self.robot,
+            robot_type=self.robot_type, mode=MODE_TO_MSG[execution.mode],
+            plan_revision=execution.revision, current_job=execution.current_job,
+            location=execution.location, destination=execution.destination,
+            progress=execution.progress(now) if now is not None else 0.0,
+            busy_until=execution.busy_until))
+
+
+def run(robot_type: str, args=None) -> int:
+    rclpy.init(args=args)
+    node = None
+    code = 0
+    try:
+        node = RobotAgent(robot_type)
+        rclpy.spin(node)
+    except ParameterError as e:
+        rclpy.logging.get_logger(f'{robot_type.lower()}_agent').error(str(e))
+        code = 2
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown()
+    return code
+
+
+def assembler_main(args=None):
+    sys.exit(run('Assembler', args))
+
+
+def marc_main(args=None):
+    sys.exit(run('MARC', args))
+
+
+def lsms_main(args=None):
+    sys.exit(run('LSMS', args))
+

@@ -1,0 +1,26 @@
+from setuptools import find_packages, setup
+
+package_name = 'robot_agents'
+
+setup(
+    name=package_name,
+    version='0.1.0',
+    packages=find_packages(exclude=['test']),
+    data_files=[
+        ('share/ament_index/resource_index/packages', ['resource/' + package_name]),
+        ('share/' + package_name, ['package.xml']),
+    ],
+    install_requires=['setuptools'],
+    zip_safe=True,
+    maintainer='fjsp team',
+    maintainer_email='team@fjsp.invalid',
+    description='Mock Assembler / MARC / LSMS agents executing planned task sequences',
+    license='Apache-2.0',
+    entry_points={
+        'console_scripts': [
+            'assembler_agent = robot_agents.agent_node:assembler_main',
+            'marc_agent = robot_agents.agent_node:marc_main',
+            'lsms_agent = robot_agents.agent_node:lsms_main',
+        ],
+    },
+)
