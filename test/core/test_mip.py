@@ -83,8 +83,17 @@ def test_start_location_and_release_time_delay_the_first_job():
     assert result.schedule.jobs['a'].start == Fraction(11, 2)
 
 
-def test_a_greedy_hint_tightens_the_horizon_and_keeps_the_optimum():
+@pytest.mark.parametrize('backend', ['SCIP', 'HIGHS'])
+def test_a_greedy_hint_tightens_the_horizon_and_keeps_the_optimum(backend):
     p = problem([('a', 'x', ((0,),)), ('b', 'y', ((0, 0),)), ('c', 'x', ((0,),))],
                 precedence=[('a', 'b')], distance=2)
     hint = greedy_schedule(p)
-    assert solved(p, hint=hint).makespan == solved(p).makespan
+    assert solved(p, backend, hint=hint).makespan == solved(p, backend).makespan
+
+
+def test_a_plan_of_another_problem_does_not_cap_the_makespan():
+    # The hint (makespan 1) is a plan of a smaller problem, as before a re-plan.
+    small = problem([('a', 'x', ((0,),))])
+    large = problem([('a', 'x', ((0,),)), ('b', 'x', ((0,),))], precedence=[('a', 'b')])
+    result = solved(large, hint=solved(small).schedule)
+    assert result.makespan == 2

@@ -42,6 +42,7 @@ from ortools.linear_solver import pywraplp
 
 from fjsp_planner.core.problem import Problem
 from fjsp_planner.core.schedule import JobAssignment, Result, Schedule, Status
+from fjsp_planner.core.validate import validate
 
 BACKENDS = ('SCIP', 'HIGHS')
 MAX_GRID = 10 ** 6
@@ -62,12 +63,16 @@ def solve_mip(problem: Problem, time_limit: float = 10.0, backend: str = 'SCIP',
         raise RuntimeError(f"OR-Tools was built without the '{backend}' MIP backend")
     if log:
         solver.EnableOutput()
-    elif backend == 'HIGHS':
-        # HiGHS prints a banner even when OR-Tools suppresses output; this silences it (the
-        # call reports failure but takes effect).
-        solver.SetSolverSpecificParametersAsString('output_flag = false')
+    if backend == 'HIGHS':
+        # OR-Tools does not pass RELATIVE_MIP_GAP on to HiGHS, and HiGHS prints a banner even
+        # when output is suppressed; its own options do both (the call reports failure but
+        # takes effect).
+        options = ['mip_rel_gap = 0'] + ([] if log else ['output_flag = false'])
+        solver.SetSolverSpecificParametersAsString('\n'.join(options))
     started = time.perf_counter()
-    model = _Model(problem, solver, hint)
+    # OR-Tools 9.15 crashes (segfault) when a MIP start is given to HiGHS; it gets the
+    # hint's horizon only.
+    model = _Model(problem, solver, hint, start_hint=backend != 'HIGHS')
     solver.SetTimeLimit(max(1, int(time_limit * 1000)))
     solver.SetNumThreads(max(1, workers))
     params = pywraplp.MPSolverParameters()
@@ -87,7 +92,7 @@ def _grid(values) -> int:
 
 
 class _Model:
-    def __init__(self, problem: Problem, solver, hint):
+    def __init__(self, problem: Problem, solver, hint, start_hint=True):
         self.p = problem
         self.solver = solver
         self.robots = [r.name for r in problem.robots]
@@ -97,7 +102,7 @@ class _Model:
         self._variables()
         self._constraints()
         if hint is not None:
-            self._hint(hint)
+            self._hint(hint, start_hint)
         solver.Minimize(self.c_max)
 
     # ----- data -------------------------------------------------------------------------
@@ -255,16 +260,22 @@ class _Model:
         return [v for (k, o, mm), v in self.ops_of[j].items()
                 if mm == m and self.ops[j, k, o][0] == q]
 
+    def _operations_of(self, job, plan, robots):
+        """{(o, m): x_jpom} giving each robot of `robots` (robot -> type) its own operation
+        of that type in the plan; robots that fit no operation are left out."""
+        free_ops = dict(enumerate(self.p.job(job).plans[plan]))
+        chosen = {}
+        for robot, q in robots.items():
+            o = next((o for o, t in free_ops.items() if t == q), None)
+            if o is not None and (job, plan, o, robot) in self.x_op:
+                chosen[o, robot] = self.x_op[job, plan, o, robot]
+                del free_ops[o]
+        return chosen
+
     def _fix(self, name, fixed):
         for k in range(len(self.p.job(name).plans)):
             self.x_plan[name, k].SetBounds(int(k == fixed.plan), int(k == fixed.plan))
-        free_ops = {o: q for o, q in enumerate(self.p.job(name).plans[fixed.plan])}
-        chosen = {}
-        for robot, q in fixed.robots.items():
-            o = next((o for o, qq in free_ops.items() if qq == q), None)
-            if o is not None:
-                chosen[o, robot] = True
-                del free_ops[o]
+        chosen = self._operations_of(name, fixed.plan, fixed.robots)
         for (j, k, o, m), x in self.x_op.items():
             if j == name:
                 value = int(k == fixed.plan and (o, m) in chosen)
@@ -275,21 +286,29 @@ class _Model:
         self.start[name].SetBounds(self._num(fixed.start), self._num(fixed.start))
         self.end[name].SetBounds(self._num(fixed.end), self._num(fixed.end))
 
-    def _hint(self, hint: Schedule):
-        """Tighten the horizon to the hint's makespan and pass its decisions as a MIP start."""
-        horizon = self._horizon(hint)
-        self.c_max.SetUb(horizon)
+    def _hint(self, hint: Schedule, start_hint: bool):
+        """Pass the parts of `hint` that name this problem's jobs and robots as a MIP start;
+        a hint that is a valid schedule of this very problem also caps the horizon (a plan
+        of an earlier problem, e.g. before a re-plan, bounds nothing)."""
+        if not validate(self.p, hint):
+            self.c_max.SetUb(self._horizon(hint))
+        if not start_hint:
+            return
         variables, values = [], []
         for j, a in hint.jobs.items():
+            if j not in self.start or not 0 <= a.plan < len(self.p.job(j).plans):
+                continue
             for k in range(len(self.p.job(j).plans)):
                 variables.append(self.x_plan[j, k])
                 values.append(float(k == a.plan))
             variables += [self.start[j], self.end[j]]
             values += [self._num(a.start), self._num(a.end)]
+            chosen = list(self._operations_of(j, a.plan, a.robots).values())
+            variables += chosen
+            values += [1.0] * len(chosen)
         for m, sequence in hint.sequences.items():
+            sequence = [j for j in sequence if (j, m) in self.x_first]
             for index, j in enumerate(sequence):
-                if (j, m) not in self.x_first:
-                    continue
                 variables += [self.x_first[j, m], self.x_last[j, m]]
                 values += [float(index == 0), float(index == len(sequence) - 1)]
                 if index + 1 < len(sequence) and (j, sequence[index + 1], m) in self.x_arc:
