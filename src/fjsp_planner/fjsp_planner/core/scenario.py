@@ -84,7 +84,7 @@ def repeat_panels(problem: Problem, panels: int, shift=DEFAULT_SHIFT) -> Problem
 
 def _number(value, what) -> Fraction:
     """Integers, decimals and 'a/b' strings, kept exact."""
-    if isinstance(value, bool) or not isinstance(value, int | float | str):
+    if isinstance(value, bool) or not isinstance(value, int | float | str | Fraction):
         raise ProblemError([f'{what}: expected a number, got {value!r}'])
     try:
         return Fraction(str(value))

@@ -1,0 +1,178 @@
+"""CP-SAT and greedy on the paper instance and on instances where one constraint decides.
+
+Each small instance has a unique optimum worked out by hand in its docstring.
+"""
+
+from fractions import Fraction
+from pathlib import Path
+
+import pytest
+
+from fjsp_planner.core.greedy import greedy_schedule
+from fjsp_planner.core.problem import FixedJob, Job, Problem, Robot
+from fjsp_planner.core.scenario import load_scenario
+from fjsp_planner.core.schedule import Status
+from fjsp_planner.core.solve import critical_path_bound, solve
+from fjsp_planner.core.validate import validate
+
+PAPER = Path(__file__).resolve().parents[2] / 'config' / 'scenarios' / 'solar_panel.yaml'
+OPS = {0: 'hold', 1: 'weld', 2: 'move'}
+
+
+def small(robots, jobs, **extra):
+    """Robots given as (name, {op: time}) each get a type of their own."""
+    types = {name: {q: Fraction(t) for q, t in times.items()} for name, times in robots}
+    fleet = tuple(extra.pop('fleet', None) or (Robot(name, name) for name, _ in robots))
+    return Problem(operation_types=OPS, robot_types=types, robots=fleet,
+                   jobs=tuple(Job(n, extra.pop(f'loc_{n}', 'here'), p) for n, p in jobs),
+                   **extra)
+
+
+def optimal(problem, **kwargs):
+    result = solve(problem, time_limit=10, workers=2, **kwargs)
+    assert result.status == Status.OPTIMAL
+    assert validate(problem, result.schedule) == []
+    assert result.makespan == result.lower_bound == result.schedule.makespan
+    return result
+
+
+def test_paper_instance_proven_optimal_at_32():
+    problem = load_scenario(PAPER)
+    result = optimal(problem)
+    assert result.makespan == 32
+    assert result.gap == 0
+
+
+def test_greedy_is_valid_and_no_better_than_optimum():
+    problem = load_scenario(PAPER, panels=2)
+    schedule = greedy_schedule(problem)
+    assert validate(problem, schedule) == []
+    assert schedule.makespan >= 64
+
+
+def test_two_panels_valid_within_bounds():
+    problem = load_scenario(PAPER, panels=2)
+    result = solve(problem, time_limit=3, workers=2)
+    assert result.status in (Status.FEASIBLE, Status.OPTIMAL)
+    assert validate(problem, result.schedule) == []
+    assert result.lower_bound <= result.makespan <= greedy_schedule(problem).makespan
+
+
+def test_alternative_plan_wins():
+    """Plan 0 needs one robot for 7; plan 1 two robots for 2 each: plan 1, makespan 2."""
+    problem = small([('r1', {0: 2, 1: 7}), ('r2', {0: 2, 1: 7})], [('x', ((1,), (0, 0)))])
+    result = optimal(problem)
+    assert result.makespan == 2
+    assert result.schedule.jobs['x'].plan == 1
+    assert set(result.schedule.jobs['x'].robots) == {'r1', 'r2'}
+
+
+def test_multi_robot_job_lasts_as_long_as_its_slowest_operation():
+    """One plan [hold, weld]: r1 holds fast but welds slowly, r2 the reverse: 3, not 9."""
+    problem = small([('r1', {0: 1, 1: 9}), ('r2', {0: 9, 1: 3})], [('x', ((0, 1),))])
+    result = optimal(problem)
+    assert result.makespan == 3
+    assert result.schedule.jobs['x'].robots == {'r1': 0, 'r2': 1}
+
+
+def test_holding_keeps_the_holder_from_other_work():
+    """Chain j -> k -> a, j held into a (type 0). Without the hold fast r1 does all: 3.
+    With it r1 holds from j to a, so slow r2 does k in 1-4 and a runs 4-5: 5."""
+    jobs = [('j', ((0,),)), ('k', ((0,),)), ('a', ((0,),))]
+    robots = [('r1', {0: 1}), ('r2', {0: 3})]
+    chain = (('j', 'k'), ('k', 'a'))
+    assert optimal(small(robots, jobs, precedence=chain)).makespan == 3
+    result = optimal(small(robots, jobs, precedence=chain, holding=(('j', 'a', 0),)))
+    assert result.makespan == 5
+    holder = next(iter(result.schedule.jobs['j'].robots))
+    assert result.schedule.jobs['a'].robots == {holder: 0}
+    route = result.schedule.sequences[holder]
+    assert route[route.index('j') + 1] == 'a'
+
+
+def travel_problem(**robot):
+    distances = {}
+    for a, b, d in (('base', 'far', 10), ('base', 'near', 1), ('far', 'near', 1)):
+        distances[a, b] = distances[b, a] = Fraction(d)
+    fleet = (Robot('r1', 'r1', Fraction(1), 'base', Fraction(robot.get('release', 0))),)
+    return small([('r1', {0: 1, 2: 1})], [('x', ((0,),)), ('y', ((0,),))], fleet=fleet,
+                 distances=distances, locomote=2, loc_x='far', loc_y='near')
+
+
+def test_travel_decides_the_order():
+    """From base: near (1), y 1-2, on to far (1), x 3-4 = 4; far first would be 13."""
+    result = optimal(travel_problem())
+    assert result.makespan == 4
+    assert result.schedule.sequences['r1'] == ('y', 'x')
+
+
+def test_release_time_and_start_location_delay_the_start():
+    """Released at 5 at base: near at 6, y 6-7, far at 8, x 8-9."""
+    result = optimal(travel_problem(release=5))
+    assert result.makespan == 9
+    assert result.schedule.jobs['y'].start == 6
+
+
+def test_per_robot_override_picks_the_faster_robot():
+    """Same type, time 10; r2 overridden to 2 for holding."""
+    problem = Problem(operation_types=OPS, robot_types={'arm': {0: Fraction(10)}},
+                      robots=(Robot('r1', 'arm'), Robot('r2', 'arm')),
+                      jobs=(Job('x', 'here', ((0,),)),),
+                      time_overrides={('r2', 0): Fraction(2)})
+    result = optimal(problem)
+    assert result.makespan == 2
+    assert result.schedule.jobs['x'].robots == {'r2': 0}
+
+
+def test_fixed_job_keeps_its_robot_until_it_ends():
+    """r1 is busy on x until 5 and is the only one able to weld y: y runs 5-6."""
+    problem = small([('r1', {0: 5, 1: 1}), ('r2', {0: 1})], [('x', ((0,),)), ('y', ((1,),))],
+                    fixed={'x': FixedJob(0, Fraction(0), Fraction(5), {'r1': 0})})
+    result = optimal(problem)
+    assert result.makespan == 6
+    assert result.schedule.jobs['x'].start == 0
+
+
+def test_rational_travel_is_exact():
+    """Speed 3: a leg of 1 takes 1/3; one robot, y then x: 1/3 + 1 + 1/3 + 1 = 8/3."""
+    distances = {('a', 'b'): Fraction(1), ('b', 'a'): Fraction(1), ('base', 'a'): Fraction(1),
+                 ('a', 'base'): Fraction(1), ('base', 'b'): Fraction(2),
+                 ('b', 'base'): Fraction(2)}
+    problem = small([('r1', {0: 1, 2: 1})], [('x', ((0,),)), ('y', ((0,),))],
+                    fleet=(Robot('r1', 'r1', Fraction(3), 'base'),), distances=distances,
+                    locomote=2, loc_x='b', loc_y='a')
+    result = optimal(problem)
+    assert result.makespan == Fraction(8, 3)
+
+
+def test_unsolvable_in_time_falls_back_to_greedy():
+    problem = load_scenario(PAPER, panels=3)
+    result = solve(problem, time_limit=0.01, workers=1)
+    assert result.schedule is not None
+    assert validate(problem, result.schedule) == []
+
+
+def test_greedy_solver_reports_a_valid_bound():
+    problem = load_scenario(PAPER)
+    result = solve(problem, solver='greedy')
+    assert result.status == Status.FEASIBLE
+    assert result.lower_bound == critical_path_bound(problem) <= 32 <= result.makespan
+
+
+def test_keep_prefers_previous_assignments_at_equal_makespan():
+    """Two identical robots, two independent jobs: both optima are fine; keep picks one."""
+    problem = small([('r1', {0: 1}), ('r2', {0: 1})], [('x', ((0,),)), ('y', ((0,),))])
+    first = optimal(problem)
+    swapped = {'x': 'r2', 'y': 'r1'} if first.schedule.jobs['x'].robots == {'r1': 0} else {
+        'x': 'r1', 'y': 'r2'}
+    previous = first.schedule.__class__(
+        {j: a.__class__(j, 0, a.start, a.end, {swapped[j]: 0})
+         for j, a in first.schedule.jobs.items()},
+        {r: tuple(j for j, who in swapped.items() if who == r) for r in ('r1', 'r2')})
+    kept = optimal(problem, keep=previous)
+    assert {j: next(iter(a.robots)) for j, a in kept.schedule.jobs.items()} == swapped
+
+
+def test_unknown_solver_is_rejected():
+    with pytest.raises(ValueError, match="unknown solver 'gurobi'"):
+        solve(load_scenario(PAPER), solver='gurobi')
