@@ -22,6 +22,8 @@ setup(
     entry_points={
         'console_scripts': [
             'fjsp-solve = fjsp_planner.cli:main',
+            'planner_node = fjsp_planner.nodes.planner:main',
+            'monitor_node = fjsp_planner.nodes.monitor:main',
         ],
     },
 )
