@@ -20,7 +20,7 @@ from pathlib import Path
 
 import pytest
 
-from fjsp_planner.core.problem import Job, Problem, Robot
+from fjsp_planner.core.problem import FixedJob, Job, Problem, Robot
 from fjsp_planner.core.replan import (
     ExecutionState,
     RobotState,
@@ -143,6 +143,16 @@ def test_aborted_held_job_keeps_its_holder(small):
     assert p.robot('A').release_time == 4 and p.robot('A').start_location == 'p'
 
 
+def test_holder_known_from_the_running_held_job(small):
+    """A plan made while W ran no longer has J; when W is aborted, W's holder is J's."""
+    later_plan = Schedule({name: a for name, a in PLAN.jobs.items() if name != 'J'},
+                          {**PLAN.sequences, 'A': ('W',)})
+    residual = residual_problem(small, at(small, 4, {'B'}), later_plan)
+    assert residual.kept == ['J']
+    # J is known to have ended by W's start at 3, after A's hold of 2.
+    assert residual.problem.fixed['J'] == FixedJob(0, Fraction(1), Fraction(4), {'A': 0})
+
+
 def test_jig_job_holding_for_a_running_job_is_gone(small):
     """At 4, W runs on healthy A and B: the hold is inside W now, J is simply done."""
     residual = residual_problem(small, at(small, 4, {'C'}), PLAN)
@@ -253,6 +263,33 @@ def test_replan_when_everything_is_done(small):
     assert result.residual.complete and result.result is None and result.schedule is None
 
 
+def test_deadlocked_holds_are_given_up():
+    """A holds from J1 for W1, B from J2 for W2, and D welds both; D fails at 3 in W1.
+    Each held job now needs the other holder as welder: no schedule keeps both holds. Given
+    up, A and B redo everything in turn from 3: J, W, J, W = 2 + 3 + 2 + 3, ending at 13."""
+    problem = Problem(
+        operation_types={0: 'hold', 1: 'weld'},
+        robot_types={'Arm': {0: Fraction(2), 1: Fraction(3)}},
+        robots=tuple(Robot(name, 'Arm') for name in 'ABD'),
+        jobs=tuple(Job(name, 'p', (plan,)) for name, plan in (
+            ('J1', (0,)), ('W1', (0, 1)), ('J2', (0,)), ('W2', (0, 1)))),
+        precedence=(('J1', 'W1'), ('J2', 'W2')),
+        holding=(('J1', 'W1', 0), ('J2', 'W2', 0)),
+    )
+    plan = Schedule(
+        jobs={'J1': assign('J1', 0, 2, {'A': 0}), 'J2': assign('J2', 0, 2, {'B': 0}),
+              'W1': assign('W1', 2, 5, {'A': 0, 'D': 1}),
+              'W2': assign('W2', 5, 8, {'B': 0, 'D': 1})},
+        sequences={'A': ('J1', 'W1'), 'B': ('J2', 'W2'), 'D': ('W1', 'W2')})
+    assert validate(problem, plan) == []
+    state = at(problem, 3, {'D'}, plan)
+    assert residual_problem(problem, state, plan).kept == ['J1', 'J2']
+    result = check_replan(problem, plan, state, time_limit=5.0)
+    assert result.residual.released == result.residual.voided == ['J1', 'J2']
+    assert result.residual.aborted == ['W1']
+    assert result.result.makespan == 13
+
+
 @pytest.fixture(scope='module')
 def paper():
     problem = load_scenario(SCENARIO)
@@ -322,6 +359,9 @@ BAD_STATES = [
     ('a robot without a state',
      lambda s: replace(s, robots={k: v for k, v in s.robots.items() if k != 'C'}),
      "no state for robot 'C'"),
+    ('a holder at work elsewhere',
+     lambda s: replace(s, running={'P': assign('P', 0, 3, {'A': 1})}),
+     "robot 'A' is running 'P' while it should still hold since 'J'"),
     ('an unknown location', lambda s: _with_robot(s, RobotState('C', True, 'moon', Fraction(4))),
      "robot 'C' is at unknown location 'moon'"),
 ]

@@ -2,7 +2,8 @@
 
 A failure turns the executing mission into a smaller problem posed at `now`:
 
-- completed jobs leave, and precedence arcs out of them are dropped;
+- completed jobs leave, and precedence arcs out of them are dropped, as are arcs into jobs
+  already running (they held when the job started);
 - a running job whose robots are all healthy stays, as a `FixedJob` with its actual start,
   plan and robots and its expected end;
 - a running job with a failed robot is aborted: it is redone from scratch, and its healthy
@@ -73,6 +74,8 @@ class Residual:
     """Completed jig jobs kept as fixed jobs of their holders, which are still holding."""
     failed: list[str] = field(default_factory=list)
     """Robots left out of the residual problem."""
+    released: list[str] = field(default_factory=list)
+    """Jig jobs whose holds were given up on request (see `replan`): voided or aborted."""
 
     @property
     def complete(self) -> bool:
@@ -100,44 +103,62 @@ def replan(problem: Problem, previous: Schedule, state: ExecutionState, time_lim
 
     The search starts from what still fits of `previous` and, among the shortest schedules
     it finds, prefers the one moving the fewest robots off their previous jobs.
+
+    Holds can deadlock: robots holding for two held jobs may each need the other's holders
+    to finish. When the residual problem has no schedule and some of its fixed jobs hold,
+    their holds are given up (done jig jobs voided, running ones aborted) and it is solved
+    again, so such a state may take up to twice `time_limit`.
     """
     residual = residual_problem(problem, state, previous)
     if residual.problem is None:
         return Replan(residual, None, [])
     result = solve(residual.problem, time_limit=time_limit, workers=workers, hint=previous,
                    keep=previous)
+    holding = {a for a, _, _ in residual.problem.holding if a in residual.problem.fixed}
+    if result.schedule is None and holding:
+        residual = residual_problem(problem, state, previous, release=holding)
+        if residual.problem is None:
+            return Replan(residual, None, [])
+        result = solve(residual.problem, time_limit=time_limit, workers=workers,
+                       hint=previous, keep=previous)
     problems = [] if result.schedule is None else validate(residual.problem, result.schedule)
     return Replan(residual, result, problems)
 
 
 def residual_problem(problem: Problem, state: ExecutionState,
-                     previous: Schedule | None = None) -> Residual:
+                     previous: Schedule | None = None, release=frozenset()) -> Residual:
     """The part of `problem` that remains in `state`, posed at `state.now`.
 
     `previous` is the schedule being executed. It tells which robots did the completed jobs,
-    which matters only for a completed jig job whose held job has not finished; without it
-    such a state raises ValueError. A state naming unknown jobs, robots or locations, or
+    which matters only for a completed jig job whose held job has not started; without it
+    such a state raises ValueError. `release` names jig jobs whose holds are given up: done
+    ones are voided, running ones aborted. A state naming unknown jobs, robots or locations, or
     contradicting itself, raises `StateError` (a ValueError) listing every issue.
     """
     _raise_on_state_problems(problem, state)
+    unknown = sorted(set(release) - {j.name for j in problem.jobs})
+    if unknown:
+        raise ValueError('release names unknown job(s) ' + ', '.join(f"'{j}'" for j in unknown))
     healthy = {name for name, robot in state.robots.items() if robot.healthy}
-    aborted = {name for name, a in state.running.items() if not set(a.robots) <= healthy}
+    aborted = {name for name, a in state.running.items()
+               if not set(a.robots) <= healthy or name in release}
     holds = _open_holds(problem, state, previous)
-    voided = {source for source, _, holders in holds if not set(holders) <= healthy}
-    aborted.update(target for source, target, _ in holds
-                   if source in voided and target in state.running)
+    voided = {h.source for h in holds if not set(h.holders) <= healthy or h.source in release}
+    aborted.update(h.target for h in holds if h.source in voided and h.target in state.running)
     fixed = {name: a for name, a in state.running.items() if name not in aborted}
-    kept = {}
-    for source, target, holders in holds:
-        if source not in voided and target not in fixed:
-            kept.setdefault(source, {}).update(holders)
-    _raise_on_hold_conflicts(kept, fixed)
+    kept, began = {}, {}
+    for h in holds:
+        if h.source not in voided and h.target not in fixed:
+            kept.setdefault(h.source, {}).update(h.holders)
+            began[h.source] = h.began
+    _raise_on_hold_conflicts(holds, kept, state.running)
 
     order = [j.name for j in problem.jobs]
     residual = Residual(
         problem=None, blocked=[], voided=[j for j in order if j in voided],
         aborted=[j for j in order if j in aborted], kept=[j for j in order if j in kept],
-        failed=[r.name for r in problem.robots if r.name not in healthy])
+        failed=[r.name for r in problem.robots if r.name not in healthy],
+        released=[j for j in order if j in release and (j in voided or j in aborted)])
     todo = [j for j in problem.jobs
             if (j.name not in state.done or j.name in voided) and j.name not in fixed]
     if not todo and not fixed:
@@ -145,32 +166,56 @@ def residual_problem(problem: Problem, state: ExecutionState,
     blocked = _staffing_problems(problem, todo, healthy, kept, residual.failed)
     if blocked:
         return replace(residual, blocked=blocked)
-    posed = _pose(problem, state, previous, healthy, todo, fixed, kept, aborted)
+    posed = _pose(problem, state, healthy, todo, fixed, kept, began, aborted)
     return replace(residual, problem=posed)
 
 
-def _open_holds(problem, state, previous):
-    """(source, target, {holder: type}) for each holding arc whose source is done but whose
-    target is not: its holders are still holding, unless they failed."""
+@dataclass(frozen=True)
+class _Hold:
+    """A holding arc whose source is done but whose target is not: its holders are still
+    holding, unless they failed."""
+
+    source: str
+    target: str
+    holders: dict[str, int]
+    began: Fraction
+    """When the source started, or at the latest could have."""
+
+
+def _open_holds(problem, state, previous) -> list[_Hold]:
+    """The holders are the source's type-q robots in `previous`; a source finished before
+    `previous` was planned is missing from it only if its target was already running then,
+    and the target's type-q robots are the holders.
+    """
     holds = []
     for source, target, q in problem.holding:
         if source not in state.done or target in state.done:
             continue
-        if previous is None or source not in previous.jobs:
+        if previous is not None and source in previous.jobs:
+            robots, began = previous.jobs[source].robots, previous.jobs[source].start
+        elif target in state.running:
+            robots, began = state.running[target].robots, None
+        else:
             raise ValueError(f"job '{source}' is done and holds for '{target}', which is "
                              f'not: pass the schedule being executed as `previous` to tell '
                              f'who holds it')
-        robots = previous.jobs[source].robots
         unknown = sorted(set(robots) - {r.name for r in problem.robots})
         if unknown:
             raise ValueError(f"previous schedule: job '{source}' names unknown robot(s) "
                              + ', '.join(f"'{r}'" for r in unknown))
-        holds.append((source, target, {r: t for r, t in robots.items() if t == q}))
+        holders = {r: t for r, t in robots.items() if t == q}
+        if began is None:
+            began = state.running[target].start - _longest(problem, holders)
+        holds.append(_Hold(source, target, holders, began))
     return holds
 
 
-def _raise_on_hold_conflicts(kept, fixed):
-    """A holder that is doing something else contradicts the hold it should keep."""
+def _longest(problem, robots: Mapping[str, int]) -> Fraction:
+    return max(problem.duration(r, q) for r, q in robots.items())
+
+
+def _raise_on_hold_conflicts(holds, kept, running):
+    """A holder at work on anything but the job it holds for contradicts its hold."""
     problems = []
     holding = {}
     for source, holders in kept.items():
@@ -179,9 +224,10 @@ def _raise_on_hold_conflicts(kept, fixed):
                 problems.append(f"robot '{robot}' cannot hold for both '{holding[robot]}' "
                                 f"and '{source}'")
             holding[robot] = source
-    for name, a in fixed.items():
+    targets = {(h.source, h.target) for h in holds}
+    for name, a in running.items():
         for robot in a.robots:
-            if robot in holding:
+            if robot in holding and (holding[robot], name) not in targets:
                 problems.append(f"robot '{robot}' is running '{name}' while it should still "
                                 f"hold since '{holding[robot]}'")
     if problems:
@@ -230,7 +276,7 @@ def _named(robots: Mapping[str, int]) -> str:
     return ', '.join(f"'{r}'" for r in sorted(robots))
 
 
-def _pose(problem, state, previous, healthy, todo, fixed, kept, aborted) -> Problem:
+def _pose(problem, state, healthy, todo, fixed, kept, began, aborted) -> Problem:
     """The residual `Problem`: todo + fixed running + kept jig jobs, healthy robots only."""
     now = state.now
     place = {}
@@ -266,8 +312,7 @@ def _pose(problem, state, previous, healthy, todo, fixed, kept, aborted) -> Prob
         # The holders have been busy holding since the jig job ended, so it ends at `now`
         # for them: the held job then cannot start in the past (the solvers apply release
         # times only to a robot's first job, and this fixed job comes first).
-        done = previous.jobs[name]
-        start = min(done.start, now - (done.end - done.start))
+        start = min(began[name], now - _longest(problem, holders))
         pinned[name] = FixedJob(0, start, now, dict(holders))
     names = {j.name for j in jobs}
     scheduled = {j.name for j in todo}
