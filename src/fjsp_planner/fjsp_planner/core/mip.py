@@ -322,8 +322,15 @@ class _Model:
         if code == pywraplp.Solver.INFEASIBLE:
             return Result(Status.INFEASIBLE, None, None, seconds, None, name, notes=self.notes)
         if not found:
-            return Result(Status.UNKNOWN, None, self._bound(), seconds, None, name,
-                          notes=self.notes)
+            known = code in (pywraplp.Solver.NOT_SOLVED, pywraplp.Solver.ABNORMAL,
+                             pywraplp.Solver.UNBOUNDED, pywraplp.Solver.MODEL_INVALID)
+            # OR-Tools 9.15 answers an undocumented code (99) when HiGHS stops at the time
+            # limit and drops its incumbent and bound with it (google/or-tools#5016, #5372).
+            notes = self.notes if known else self.notes + (
+                f'the backend stopped with status code {code} and returned no solution or '
+                'bound (HiGHS at a time limit: OR-Tools 9.15 drops its incumbent)',)
+            return Result(Status.UNKNOWN, None, self._bound() if known else None, seconds,
+                          None, name, notes=notes)
         schedule = self._schedule()
         bound = self._bound()
         if code == pywraplp.Solver.OPTIMAL:
