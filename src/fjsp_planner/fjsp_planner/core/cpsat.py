@@ -114,7 +114,7 @@ class _Model:
         self.robots = [r.name for r in problem.robots]
         self.start, self.end, self.plan = {}, {}, {}
         self.does = {}
-        """(job, plan, op type, robot) -> literal: the robot does a type-q operation."""
+        """(job, robot) -> [(plan, op type, literal)]: the robot does a type-q operation."""
         self.on_job = {}
         self.arcs = {}
         self.route_nodes = {}
@@ -129,14 +129,16 @@ class _Model:
         self._panels()
 
     def ticks(self, value: Fraction) -> int:
-        return math.ceil(value * self.scale)
+        """Grid units, rounded up (integer arithmetic: this runs for every route arc)."""
+        return -(-value.numerator * self.scale // value.denominator)
 
     def _choose_scale(self):
         p = self.problem
         values = [p.duration(r.name, q) for r in p.robots for q in p.operation_types]
         locations = p.locations()
-        values += [p.travel(r.name, a, b) for r in p.robots for a in locations
-                   for b in locations]
+        self.legs = {(r.name, a, b): p.travel(r.name, a, b) for r in p.robots
+                     for a in locations for b in locations}
+        values += self.legs.values()
         denominators = {v.denominator for v in values if v is not None}
         scale = math.lcm(*denominators) if denominators else 1
         if scale > MAX_SCALE:
@@ -173,15 +175,16 @@ class _Model:
                 plans.append(chosen)
                 for q in set(plan):
                     able = [r for r in self.robots if p.duration(r, q) is not None]
+                    literals = []
                     for r in able:
                         if fixed is not None:
                             value = int(index == fixed.plan and fixed.robots.get(r) == q)
-                            self.does[name, index, q, r] = m.new_constant(value)
+                            literal = m.new_constant(value)
                         else:
-                            self.does[name, index, q, r] = m.new_bool_var(
-                                f'does_{name}_{index}_{q}_{r}')
-                    m.add(sum(self.does[name, index, q, r] for r in able)
-                          == plan.count(q) * chosen)
+                            literal = m.new_bool_var(f'does_{name}_{index}_{q}_{r}')
+                        self.does.setdefault((name, r), []).append((index, q, literal))
+                        literals.append(literal)
+                    m.add(sum(literals) == plan.count(q) * chosen)
             m.add_exactly_one(plans)
             if fixed is None:
                 duration = m.new_int_var(0, self.horizon, f'duration_{name}')
@@ -190,8 +193,7 @@ class _Model:
                 duration = fixed_ticks[1] - fixed_ticks[0]
             longest = []
             for r in self.robots:
-                mine = [(lit, q) for (j, _, q, robot), lit in self.does.items()
-                        if j == name and robot == r]
+                mine = [(lit, q) for _, q, lit in self.does.get((name, r), ())]
                 if not mine:
                     continue
                 on = m.new_bool_var(f'on_{name}_{r}')
@@ -248,7 +250,7 @@ class _Model:
                     arc = m.new_bool_var(f'next_{a}_{b}_{r}')
                     self.arcs[a, b, r] = arc
                     arcs.append((node[a], node[b], arc))
-                    leg = self.ticks(p.travel(r, p.job(a).location, p.job(b).location))
+                    leg = self.ticks(self.legs[r, p.job(a).location, p.job(b).location])
                     m.add(self.start[b] >= self.end[a] + leg).only_enforce_if(arc)
             m.add_circuit(arcs)
 
@@ -256,10 +258,8 @@ class _Model:
         p, m = self.problem, self.model
         for a, b, q in p.holding:
             for r in self.robots:
-                in_a = sum(lit for (j, _, t, robot), lit in self.does.items()
-                           if j == a and t == q and robot == r)
-                in_b = sum(lit for (j, _, t, robot), lit in self.does.items()
-                           if j == b and t == q and robot == r)
+                in_a = sum(lit for _, t, lit in self.does.get((a, r), ()) if t == q)
+                in_b = sum(lit for _, t, lit in self.does.get((b, r), ()) if t == q)
                 if isinstance(in_a, int) and isinstance(in_b, int):
                     continue
                 m.add(in_a == in_b)
@@ -289,8 +289,8 @@ class _Model:
             crossing_cost[r] = cost
             crossings = m.new_int_var(0, len(p.panels), f'panel_crossings_{r}')
             m.add(crossings >= sum(visits) - 1)
-            work = sum(lit * self.ticks(p.duration(robot_name, q))
-                       for (_, _, q, robot_name), lit in self.does.items() if robot_name == r)
+            work = sum(lit * self.ticks(p.duration(r, q)) for j in self.route_nodes[r]
+                       for _, q, lit in self.does[j, r])
             m.add(work + self.ticks(cost) * crossings + self.ticks(robot.release_time)
                   <= self.makespan)
         if any(r.start_location for r in p.robots):
@@ -312,8 +312,8 @@ class _Model:
             m.add_hint(self.end[name], self.ticks(a.end))
             for index in range(len(p.job(name).plans)):
                 m.add_hint(self.plan[name, index], int(index == a.plan))
-            for (j, index, q, r), lit in self.does.items():
-                if j == name:
+            for r in self.robots:
+                for index, q, lit in self.does.get((name, r), ()):
                     m.add_hint(lit, int(index == a.plan and a.robots.get(r) == q))
         for r, sequence in schedule.sequences.items():
             if r not in self.route_nodes:
@@ -334,8 +334,8 @@ class _Model:
                                            dict(fixed.robots))
                 continue
             plan = next(i for i in range(len(job.plans)) if solver.value(self.plan[name, i]))
-            robots = {r: q for (j, index, q, r), lit in self.does.items()
-                      if j == name and index == plan and solver.value(lit)}
+            robots = {r: q for r in self.robots for index, q, lit in self.does.get((name, r), ())
+                      if index == plan and solver.value(lit)}
             start = Fraction(solver.value(self.start[name]), self.scale)
             end = start + max(p.duration(r, q) for r, q in robots.items())
             jobs[name] = JobAssignment(name, plan, start, end, robots)

@@ -7,6 +7,7 @@ type-q robots, so no other job can come between them on the holders' routes.
 
 import itertools
 import random
+import time
 from fractions import Fraction
 
 from fjsp_planner.core.problem import Problem
@@ -19,11 +20,16 @@ class GreedyStuckError(RuntimeError):
     """No job can be placed although some remain (e.g. held robots are needed elsewhere)."""
 
 
-def greedy_schedule(problem: Problem, passes: int = 16, seed: int = 0) -> Schedule:
-    """Best of several randomised passes; the first pass is deterministic."""
+def greedy_schedule(problem: Problem, passes: int = 16, seed: int = 0,
+                    time_budget: float = 0.15) -> Schedule:
+    """Best of up to `passes` randomised passes, the first deterministic; passes after the
+    first stop once `time_budget` seconds are spent, so large problems stay fast."""
     rng = random.Random(seed)
     best, stuck = None, None
+    began = time.monotonic()
     for attempt in range(passes):
+        if attempt and best is not None and time.monotonic() - began > time_budget:
+            break
         try:
             schedule = _one_pass(problem, rng if attempt else None)
         except GreedyStuckError as error:

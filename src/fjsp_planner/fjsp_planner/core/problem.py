@@ -75,6 +75,7 @@ class Problem:
             raise ProblemError(problems)
         object.__setattr__(self, '_robot_by_name', {r.name: r for r in self.robots})
         object.__setattr__(self, '_job_by_name', {j.name: j for j in self.jobs})
+        object.__setattr__(self, '_travel_cache', {})
         problems = _cycle_problems(self) + _holding_problems(self) + _staffing_problems(self)
         if problems:
             raise ProblemError(problems)
@@ -101,11 +102,12 @@ class Problem:
         """Time for `robot` to move from location a to location b."""
         if self.locomote is None or a == b:
             return Fraction(0)
-        distance = self.distance(a, b)
-        if distance == 0:
-            return Fraction(0)
-        r = self.robot(robot)
-        return distance * self.robot_types[r.type][self.locomote] / r.speed
+        key = (robot, a, b)
+        if key not in self._travel_cache:
+            r = self.robot(robot)
+            self._travel_cache[key] = (self.distance(a, b)
+                                       * self.robot_types[r.type][self.locomote] / r.speed)
+        return self._travel_cache[key]
 
     def locations(self) -> list[str]:
         names = {j.location for j in self.jobs}
