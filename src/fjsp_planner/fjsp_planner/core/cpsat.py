@@ -38,6 +38,7 @@ def solve_cpsat(problem: Problem, time_limit=10.0, workers=2, hint: Schedule | N
         model.add_hint(hint or upper_bound)
     model.model.minimize(model.makespan)
     keep_time = time_limit * KEEP_SHARE if keep is not None else 0.0
+    setup = time.monotonic() - began
     solver, recorder, status = _run(model.model, time_limit - keep_time, workers, log)
     if status in ('INFEASIBLE',):
         return Result(Status.INFEASIBLE, None, None, time.monotonic() - began, None, 'cpsat',
@@ -59,7 +60,12 @@ def solve_cpsat(problem: Problem, time_limit=10.0, workers=2, hint: Schedule | N
     return Result(
         Status.OPTIMAL if proven and model.exact else Status.FEASIBLE,
         makespan, lower_bound, time.monotonic() - began, schedule, 'cpsat',
-        first_solution_seconds=recorder.first, notes=model.notes)
+        first_solution_seconds=_since_call(recorder.first, setup),
+        best_solution_seconds=_since_call(recorder.best, setup), notes=model.notes)
+
+
+def _since_call(solver_seconds, setup):
+    return None if solver_seconds is None else setup + solver_seconds
 
 
 def _run(model, time_limit, workers, log):
@@ -67,20 +73,26 @@ def _run(model, time_limit, workers, log):
     solver.parameters.max_time_in_seconds = max(0.01, time_limit)
     solver.parameters.num_workers = workers
     solver.parameters.log_search_progress = log
-    recorder = _FirstSolution()
+    # Presolve probing took the whole budget at 5 panels before any search (and slowed the
+    # 1-panel proof 2x), while it did not tighten the bound measurably at 2 panels.
+    solver.parameters.cp_model_probing_level = 0
+    recorder = _SolutionTimes()
     # status_name() without an argument is broken in ortools 9.15; name the returned status.
     status = solver.solve(model, recorder).name
     return solver, recorder, status
 
 
-class _FirstSolution(cp_model.CpSolverSolutionCallback):
+class _SolutionTimes(cp_model.CpSolverSolutionCallback):
+    """When the first and the last (best) solutions arrived, in solver wall time."""
+
     def __init__(self):
         super().__init__()
-        self.first = None
+        self.first = self.best = None
 
     def on_solution_callback(self):
         if self.first is None:
             self.first = self.wall_time
+        self.best = self.wall_time
 
 
 def _keep_assignments(model, solver, best, keep, time_limit, workers, log):
@@ -119,6 +131,10 @@ class _Model:
         self.arcs = {}
         self.route_nodes = {}
         """robot -> the jobs on its circuit, in circuit node order."""
+        self.symmetry = None
+        """(robot, first panel, last panel) when mirrored panels are cut off."""
+        self.duration, self.used, self.first_arc, self.last_arc = {}, {}, {}, {}
+        self.panel_visits, self.crossings = {}, {}
         self._jobs()
         self._precedence()
         self._routes()
@@ -187,7 +203,8 @@ class _Model:
                     m.add(sum(literals) == plan.count(q) * chosen)
             m.add_exactly_one(plans)
             if fixed is None:
-                duration = m.new_int_var(0, self.horizon, f'duration_{name}')
+                duration = self.duration[name] = m.new_int_var(0, self.horizon,
+                                                               f'duration_{name}')
                 m.add(end == start + duration)
             else:
                 duration = fixed_ticks[1] - fixed_ticks[0]
@@ -230,15 +247,16 @@ class _Model:
             if not jobs:
                 continue
             node = {name: i + 1 for i, name in enumerate(jobs)}
-            used = m.new_bool_var(f'used_{r}')
+            used = self.used[r] = m.new_bool_var(f'used_{r}')
             m.add_max_equality(used, [self.on_job[j, r] for j in jobs])
             arcs = [(0, 0, ~used)]
             for a in jobs:
                 on = self.on_job[a, r]
                 arcs.append((node[a], node[a], ~on))
-                first = m.new_bool_var(f'first_{a}_{r}')
+                first = self.first_arc[a, r] = m.new_bool_var(f'first_{a}_{r}')
+                last = self.last_arc[a, r] = m.new_bool_var(f'last_{a}_{r}')
                 arcs.append((0, node[a], first))
-                arcs.append((node[a], 0, m.new_bool_var(f'last_{a}_{r}')))
+                arcs.append((node[a], 0, last))
                 if a not in p.fixed:
                     ready = robot.release_time
                     if robot.start_location is not None:
@@ -283,11 +301,13 @@ class _Model:
                 visit = m.new_bool_var(f'visits_panel_{k + 1}_{r}')
                 m.add_max_equality(visit, on or [0])
                 visits.append(visit)
+            self.panel_visits[r] = visits
             cost = min(p.travel(r, p.job(a).location, p.job(b).location)
                        for k, first in enumerate(p.panels) for second in p.panels[k + 1:]
                        for a in first for b in second)
             crossing_cost[r] = cost
-            crossings = m.new_int_var(0, len(p.panels), f'panel_crossings_{r}')
+            crossings = self.crossings[r] = m.new_int_var(0, len(p.panels),
+                                                          f'panel_crossings_{r}')
             m.add(crossings >= sum(visits) - 1)
             work = sum(lit * self.ticks(p.duration(r, q)) for j in self.route_nodes[r]
                        for _, q, lit in self.does[j, r])
@@ -299,29 +319,75 @@ class _Model:
         first, last = p.panels[0], p.panels[-1]
         m.add(sum(self.on_job[j, slowest] for j in first if (j, slowest) in self.on_job)
               >= sum(self.on_job[j, slowest] for j in last if (j, slowest) in self.on_job))
+        self.symmetry = (slowest, first, last)
+
+    def _respecting_symmetry(self, schedule: Schedule) -> Schedule:
+        """The schedule, or its mirror image if that is the one the symmetry cut allows."""
+        if self.symmetry is None:
+            return schedule
+        robot, first, last = self.symmetry
+        route = set(schedule.sequences.get(robot, ()))
+        if len(route & set(first)) >= len(route & set(last)):
+            return schedule
+        panels = self.problem.panels
+        mirror = {job: panels[-1 - k][i] for k, names in enumerate(panels)
+                  for i, job in enumerate(names)}
+        if any(job not in mirror for job in schedule.jobs):
+            return schedule
+        return Schedule(
+            {mirror[j]: JobAssignment(mirror[j], a.plan, a.start, a.end, a.robots)
+             for j, a in schedule.jobs.items()},
+            {r: tuple(mirror[j] for j in route) for r, route in schedule.sequences.items()})
 
     def add_hint(self, schedule: Schedule):
-        """Hint every part of `schedule` that names this problem's jobs and robots."""
+        """Hint every variable that `schedule` determines, skipping what the problem lacks.
+
+        A complete hint lets CP-SAT start from it at once instead of repairing it by search.
+        """
         m, p = self.model, self.problem
+        schedule = self._respecting_symmetry(schedule)
+        ends = {}
         for name, a in schedule.jobs.items():
-            if name not in self.start or name in p.fixed:
+            if name not in self.start or a.plan >= len(p.job(name).plans):
                 continue
-            if a.plan >= len(p.job(name).plans):
+            if name in p.fixed:
+                ends[name] = self.ticks(p.fixed[name].end)
                 continue
-            m.add_hint(self.start[name], self.ticks(a.start))
-            m.add_hint(self.end[name], self.ticks(a.end))
+            start = self.ticks(a.start)
+            robots = {r: q for r, q in a.robots.items() if (name, r) in self.does}
+            longest = max((self.ticks(p.duration(r, q)) for r, q in robots.items()
+                           if p.duration(r, q) is not None), default=0)
+            ends[name] = start + longest
+            m.add_hint(self.start[name], start)
+            m.add_hint(self.end[name], ends[name])
+            m.add_hint(self.duration[name], longest)
             for index in range(len(p.job(name).plans)):
                 m.add_hint(self.plan[name, index], int(index == a.plan))
             for r in self.robots:
                 for index, q, lit in self.does.get((name, r), ()):
-                    m.add_hint(lit, int(index == a.plan and a.robots.get(r) == q))
-        for r, sequence in schedule.sequences.items():
-            if r not in self.route_nodes:
-                continue
-            route = [j for j in sequence if j in self.start]
-            for a, b in zip(route, route[1:], strict=False):
-                if (a, b, r) in self.arcs:
-                    m.add_hint(self.arcs[a, b, r], 1)
+                    m.add_hint(lit, int(index == a.plan and robots.get(r) == q))
+        for r, jobs in self.route_nodes.items():
+            route = [j for j in schedule.sequences.get(r, ())
+                     if j in ends and r in schedule.jobs[j].robots]
+            successor = dict(zip(route, route[1:], strict=False))
+            for j in jobs:
+                m.add_hint(self.on_job[j, r], int(j in route))
+                m.add_hint(self.first_arc[j, r], int(bool(route) and route[0] == j))
+                m.add_hint(self.last_arc[j, r], int(bool(route) and route[-1] == j))
+            for (a, b, robot), arc in self.arcs.items():
+                if robot == r:
+                    m.add_hint(arc, int(successor.get(a) == b))
+            if jobs:
+                m.add_hint(self.used[r], int(bool(route)))
+            if r in self.panel_visits:
+                panel_of = {j: k for k, names in enumerate(p.panels) for j in names}
+                stays = [panel_of[j] for j in route]
+                for k, visit in enumerate(self.panel_visits[r]):
+                    m.add_hint(visit, int(k in stays))
+                m.add_hint(self.crossings[r], sum(a != b for a, b in zip(
+                    stays, stays[1:], strict=False)))
+        if len(ends) == len(self.start):
+            m.add_hint(self.makespan, max(ends.values(), default=0))
 
     def read(self, solver) -> Schedule:
         p = self.problem

@@ -72,6 +72,7 @@ class Result:
     schedule: Schedule | None
     solver: str
     first_solution_seconds: float | None = None
+    best_solution_seconds: float | None = None
     notes: tuple[str, ...] = field(default=())
     """How the solver treated the input, e.g. the time grid it scaled to."""
 

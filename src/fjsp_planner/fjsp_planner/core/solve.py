@@ -1,5 +1,6 @@
 """One entry point for every backend, returning the solver-neutral `Result`."""
 
+import dataclasses
 import time
 from fractions import Fraction
 
@@ -35,7 +36,8 @@ def solve(problem: Problem, solver: str = 'cpsat', time_limit: float = 10.0, wor
         elapsed = time.monotonic() - began
         return Result(Status.FEASIBLE, greedy.makespan, critical_path_bound(problem), elapsed,
                       greedy, 'greedy', first_solution_seconds=elapsed)
-    remaining = max(0.05, time_limit - (time.monotonic() - began))
+    setup = time.monotonic() - began
+    remaining = max(0.05, time_limit - setup)
     if solver == 'mip':
         from fjsp_planner.core.mip import solve_mip
 
@@ -45,11 +47,28 @@ def solve(problem: Problem, solver: str = 'cpsat', time_limit: float = 10.0, wor
         result = solve_cpsat(problem, remaining, workers, hint=hint, keep=keep,
                              upper_bound=greedy, log=log)
     if result.schedule is None and greedy is not None and result.status != Status.INFEASIBLE:
-        return Result(Status.FEASIBLE, greedy.makespan, critical_path_bound(problem),
-                      time.monotonic() - began, greedy, 'greedy',
+        elapsed = time.monotonic() - began
+        return Result(Status.FEASIBLE, greedy.makespan, critical_path_bound(problem), elapsed,
+                      greedy, 'greedy', first_solution_seconds=setup,
+                      best_solution_seconds=setup,
                       notes=result.notes + (f'{result.solver} found no schedule in '
                                             f'{time_limit:g} s; greedy schedule returned',))
-    return result
+    return _count_from(problem, result, setup)
+
+
+def _count_from(problem: Problem, result: Result, setup: float) -> Result:
+    """The backend's times counted from the call, and its bound no weaker than the
+    critical path (an early-stopped search may not have reached even that)."""
+    def shifted(seconds):
+        return None if seconds is None else seconds + setup
+
+    bound = result.lower_bound
+    if bound is not None:
+        bound = min(max(bound, critical_path_bound(problem)), result.makespan)
+    return dataclasses.replace(
+        result, lower_bound=bound, solve_seconds=result.solve_seconds + setup,
+        first_solution_seconds=shifted(result.first_solution_seconds),
+        best_solution_seconds=shifted(result.best_solution_seconds))
 
 
 def critical_path_bound(problem: Problem) -> Fraction:

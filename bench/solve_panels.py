@@ -1,0 +1,48 @@
+"""Solve 1, 2, 3 and 5 solar panels with CP-SAT and print how fast it gets where.
+
+Usage: python bench/solve_panels.py [--time-limit 60] [--workers 2] [--panels 1 2 3 5]
+Prints, never asserts: time to first solution, to best, status, bound and gap per size.
+"""
+
+import argparse
+import os
+import platform
+import sys
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(REPO / 'src' / 'fjsp_planner'))
+
+from fjsp_planner.core.scenario import load_scenario  # noqa: E402
+from fjsp_planner.core.solve import solve  # noqa: E402
+from fjsp_planner.core.validate import validate  # noqa: E402
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument('--time-limit', type=float, default=60.0)
+    parser.add_argument('--workers', type=int, default=2)
+    parser.add_argument('--panels', type=int, nargs='+', default=[1, 2, 3, 5])
+    parser.add_argument('--scenario', default=str(REPO / 'config/scenarios/solar_panel.yaml'))
+    args = parser.parse_args()
+    print(f'machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores; '
+          f'CP-SAT {args.workers} workers, limit {args.time_limit:g} s')
+    print(f"{'panels':>6} {'jobs':>5} {'first s':>8} {'best s':>8} {'total s':>8} "
+          f"{'status':>9} {'makespan':>9} {'bound':>8} {'gap':>7} valid")
+    for panels in args.panels:
+        problem = load_scenario(args.scenario, panels=panels)
+        result = solve(problem, time_limit=args.time_limit, workers=args.workers)
+        valid = result.schedule is not None and not validate(problem, result.schedule)
+        print(f'{panels:>6} {len(problem.jobs):>5} {_s(result.first_solution_seconds)} '
+              f'{_s(result.best_solution_seconds)} {result.solve_seconds:>8.2f} '
+              f'{result.status.value:>9} {float(result.makespan):>9.2f} '
+              f'{float(result.lower_bound):>8.2f} {100 * result.gap:>6.1f}% {valid}',
+              flush=True)
+
+
+def _s(seconds):
+    return f'{seconds:>8.2f}' if seconds is not None else f"{'-':>8}"
+
+
+if __name__ == '__main__':
+    main()
