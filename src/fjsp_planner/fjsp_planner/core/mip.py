@@ -294,26 +294,33 @@ class _Model:
             self.c_max.SetUb(self._horizon(hint))
         if not start_hint:
             return
-        variables, values = [], []
+        # SCIP ignores a start that leaves most variables open, so every binary gets a value:
+        # 0 unless the hint sets it.
+        values = {}
+        for group in (self.x_plan, self.x_op, self.x_on, self.x_arc, self.x_first,
+                      self.x_last):
+            for x in group.values():
+                values[x.index()] = (x, 0.0)
         for j, a in hint.jobs.items():
             if j not in self.start or not 0 <= a.plan < len(self.p.job(j).plans):
                 continue
-            for k in range(len(self.p.job(j).plans)):
-                variables.append(self.x_plan[j, k])
-                values.append(float(k == a.plan))
-            variables += [self.start[j], self.end[j]]
-            values += [self._num(a.start), self._num(a.end)]
-            chosen = list(self._operations_of(j, a.plan, a.robots).values())
-            variables += chosen
-            values += [1.0] * len(chosen)
+            chosen = [self.x_plan[j, a.plan], *self._operations_of(j, a.plan, a.robots).values()]
+            chosen += [self.x_on[j, m] for m in a.robots if (j, m) in self.x_on]
+            for x in chosen:
+                values[x.index()] = (x, 1.0)
+            for x, time_ in ((self.start[j], a.start), (self.end[j], a.end)):
+                values[x.index()] = (x, self._num(time_))
         for m, sequence in hint.sequences.items():
             sequence = [j for j in sequence if (j, m) in self.x_first]
-            for index, j in enumerate(sequence):
-                variables += [self.x_first[j, m], self.x_last[j, m]]
-                values += [float(index == 0), float(index == len(sequence) - 1)]
-                if index + 1 < len(sequence) and (j, sequence[index + 1], m) in self.x_arc:
-                    variables.append(self.x_arc[j, sequence[index + 1], m])
-                    values.append(1.0)
+            chosen = [self.x_first[sequence[0], m], self.x_last[sequence[-1], m]] \
+                if sequence else []
+            chosen += [self.x_arc[a, b, m] for a, b in zip(sequence, sequence[1:], strict=False)
+                       if (a, b, m) in self.x_arc]
+            for x in chosen:
+                values[x.index()] = (x, 1.0)
+        values[self.c_max.index()] = (self.c_max, self._num(hint.makespan))
+        variables = [x for x, _ in values.values()]
+        values = [v for _, v in values.values()]
         self.solver.SetHint(variables, values)
 
     # ----- answer -----------------------------------------------------------------------
