@@ -161,6 +161,13 @@ def test_jig_job_holding_for_a_running_job_is_gone(small):
     assert residual.problem.holding == ()
 
 
+def test_late_running_job_ends_no_earlier_than_now(small):
+    """P was expected to end at 3 but still runs at 7/2: nothing may follow it before 7/2."""
+    state = replace(at(small, Fraction(5, 2), {'C'}), now=Fraction(7, 2))
+    fixed = residual_problem(small, state, PLAN).problem.fixed['P']
+    assert (fixed.start, fixed.end) == (0, Fraction(7, 2))
+
+
 def test_failure_after_the_robots_last_job(small):
     """A fails at 7, after W: only F, running on C, remains."""
     residual = residual_problem(small, at(small, 7, {'A'}), PLAN)

@@ -17,7 +17,8 @@ A failure turns the executing mission into a smaller problem posed at `now`:
   max(now, free_at); a failed robot is left out, so it gets nothing.
 
 A job the healthy robots cannot staff is reported in `Residual.blocked`, never raised: the
-robot may come back, and a later state then gives a solvable residual.
+robot may come back, and a later state then gives a solvable residual. Holds that leave no
+schedule at all (each holder waiting for the other's held job) are given up by `replan`.
 """
 
 from collections import Counter
@@ -101,7 +102,7 @@ def replan(problem: Problem, previous: Schedule, state: ExecutionState, time_lim
            workers=2) -> Replan:
     """Re-plan what remains of `problem` in `state`, `previous` being the schedule executed.
 
-    The search starts from what still fits of `previous` and, among the shortest schedules
+    The search starts from `previous` when it still works and, among the shortest schedules
     it finds, prefers the one moving the fewest robots off their previous jobs.
 
     Holds can deadlock: robots holding for two held jobs may each need the other's holders
@@ -112,17 +113,44 @@ def replan(problem: Problem, previous: Schedule, state: ExecutionState, time_lim
     residual = residual_problem(problem, state, previous)
     if residual.problem is None:
         return Replan(residual, None, [])
-    result = solve(residual.problem, time_limit=time_limit, workers=workers, hint=previous,
-                   keep=previous)
+    result = _solve(residual.problem, previous, time_limit, workers)
     holding = {a for a, _, _ in residual.problem.holding if a in residual.problem.fixed}
     if result.schedule is None and holding:
         residual = residual_problem(problem, state, previous, release=holding)
         if residual.problem is None:
             return Replan(residual, None, [])
-        result = solve(residual.problem, time_limit=time_limit, workers=workers,
-                       hint=previous, keep=previous)
+        result = _solve(residual.problem, previous, time_limit, workers)
     problems = [] if result.schedule is None else validate(residual.problem, result.schedule)
     return Replan(residual, result, problems)
+
+
+def _solve(residual: Problem, previous: Schedule, time_limit, workers) -> Result:
+    """Solve, keeping close to `previous`, and starting from it if it still works.
+
+    A previous plan broken by the failure is a poor start: CP-SAT repairing its stale parts
+    can take longer than finding a schedule afresh from the greedy one.
+    """
+    projected = _project(residual, previous)
+    hint = projected if projected is not None and not validate(residual, projected) else None
+    return solve(residual, time_limit=time_limit, workers=workers, hint=hint, keep=previous)
+
+
+def _project(residual: Problem, previous: Schedule) -> Schedule | None:
+    """`previous` restricted to the residual problem, or None if it misses one of its jobs."""
+    jobs = {}
+    for job in residual.jobs:
+        fixed = residual.fixed.get(job.name)
+        if fixed is not None:
+            jobs[job.name] = JobAssignment(job.name, fixed.plan, fixed.start, fixed.end,
+                                           dict(fixed.robots))
+        elif job.name in previous.jobs:
+            jobs[job.name] = previous.jobs[job.name]
+        else:
+            return None
+    sequences = {r.name: tuple(j for j in previous.sequences.get(r.name, ())
+                               if j in jobs and r.name in jobs[j].robots)
+                 for r in residual.robots}
+    return Schedule(jobs, sequences)
 
 
 def residual_problem(problem: Problem, state: ExecutionState,

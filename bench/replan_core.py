@@ -1,0 +1,144 @@
+"""Re-planning after injected robot failures: latency, and quality against a cold solve.
+
+For each panel count of the paper scenario: solve the mission (optimal for one panel, the
+best found in --plan-limit seconds beyond), then inject --faults single-robot failures at
+seeded random times into its on-plan execution (`simulated_state`), and time `replan()`
+(residual problem + CP-SAT warm-started from and kept close to the plan + validation).
+On the --cold earliest faults, the same residual problem is also solved cold (no hint, no
+keep) for --cold-limit seconds, to see what the re-plan's short time limit costs.
+
+Prints figures and never asserts. Default run: 5 to 9 minutes on 2 cores.
+
+    ros2_ws/.venv/bin/python bench/replan_core.py [--panels 1 2 5] [--faults 20]
+"""
+
+import argparse
+import random
+import statistics
+import sys
+import time
+from fractions import Fraction
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(REPO / 'src' / 'fjsp_planner'))
+
+from fjsp_planner.core.replan import replan, simulated_state  # noqa: E402
+from fjsp_planner.core.scenario import load_scenario  # noqa: E402
+from fjsp_planner.core.solve import solve  # noqa: E402
+
+SCENARIO = REPO / 'config' / 'scenarios' / 'solar_panel.yaml'
+REPLAN_LIMIT = {1: 1.0, 2: 2.0, 5: 3.0}
+"""Seconds given to each re-plan, by panel count (others: 3)."""
+PLAN_LIMIT = {1: 30.0, 2: 20.0, 5: 30.0}
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument('--panels', type=int, nargs='+', default=[1, 2, 5])
+    parser.add_argument('--faults', type=int, default=20, help='failures per panel count')
+    parser.add_argument('--cold', type=int, default=3,
+                        help='earliest faults per panel count also solved cold')
+    parser.add_argument('--cold-limit', type=float, default=60.0)
+    parser.add_argument('--workers', type=int, default=2)
+    parser.add_argument('--seed', type=int, default=0)
+    args = parser.parse_args()
+
+    began = time.monotonic()
+    summary, comparisons = [], []
+    for panels in args.panels:
+        rows, cold = bench_panels(panels, args)
+        summary.append(rows)
+        comparisons += cold
+    print_summary(summary)
+    print_comparisons(comparisons, args.cold_limit)
+    print(f'\ntotal {time.monotonic() - began:.0f} s, workers={args.workers}, seed={args.seed}')
+
+
+def bench_panels(panels, args):
+    problem = load_scenario(SCENARIO, panels=panels)
+    plan = solve(problem, time_limit=PLAN_LIMIT.get(panels, 30.0), workers=args.workers)
+    makespan = plan.makespan
+    limit = REPLAN_LIMIT.get(panels, 3.0)
+    print(f'{panels} panel(s): plan makespan {float(makespan):.2f} ({plan.status}, bound '
+          f'{float(plan.lower_bound or 0):.2f}); re-plans at {limit:g} s', flush=True)
+    rng = random.Random(args.seed * 1000 + panels)
+    robots = [r.name for r in problem.robots]
+    latencies, delays, statuses, replanned, cold = [], [], {}, [], []
+    for index in range(args.faults):
+        # Tenths of a unit, as a wall clock would give: off the solver's 1/30 grid.
+        now = Fraction(rng.randrange(0, int(makespan * 10)), 10)
+        robot = rng.choice(robots)
+        state = simulated_state(problem, plan.schedule, now, {robot})
+        t0 = time.monotonic()
+        outcome = replan(problem, plan.schedule, state, time_limit=limit, workers=args.workers)
+        latencies.append(time.monotonic() - t0)
+        status = 'blocked' if outcome.result is None else str(outcome.result.status)
+        if outcome.residual.released:
+            status += '/holds given up'
+        if outcome.problems:
+            status += ' INVALID'
+        statuses[status] = statuses.get(status, 0) + 1
+        print(f'  fault {index + 1:2}: {robot:9} at {float(now):6.1f} -> {status}, '
+              f'{latencies[-1]:.2f} s', flush=True)
+        if outcome.result is None or outcome.result.makespan is None:
+            continue
+        delays.append(outcome.result.makespan - makespan)
+        replanned.append((now, robot, outcome))
+    # The earliest faults leave the most to re-plan: those are the ones worth comparing.
+    for now, robot, outcome in sorted(replanned, key=lambda row: row[0])[:args.cold]:
+        t0 = time.monotonic()
+        fresh = solve(outcome.residual.problem, time_limit=args.cold_limit,
+                      workers=args.workers)
+        cold.append(dict(
+            panels=panels, now=now, robot=robot, replan=outcome.result.makespan,
+            replan_moves=moves(plan.schedule, outcome), cold=fresh.makespan,
+            cold_bound=fresh.lower_bound, cold_status=fresh.status,
+            cold_seconds=time.monotonic() - t0,
+            cold_moves=moves(plan.schedule, outcome, fresh.schedule)))
+    return dict(panels=panels, plan=makespan, limit=limit, latencies=latencies,
+                delays=delays, statuses=statuses), cold
+
+
+def moves(previous, outcome, schedule=None):
+    """(job, robot) pairs of the new plan's decided jobs that the previous plan did not have."""
+    schedule = schedule or outcome.schedule
+    fixed = outcome.residual.problem.fixed
+    before = {(j, r) for j, a in previous.jobs.items() for r in a.robots}
+    return sum((j, r) not in before for j, a in schedule.jobs.items() if j not in fixed
+               for r in a.robots)
+
+
+def percentile(values, share):
+    ordered = sorted(values)
+    return ordered[min(len(ordered) - 1, round(share * (len(ordered) - 1)))]
+
+
+def print_summary(summary):
+    print('\npanels  plan    limit  faults  p50 s  p95 s  max s  mean delay  statuses')
+    for s in summary:
+        lat = s['latencies']
+        delay = float(statistics.mean(s['delays'])) if s['delays'] else float('nan')
+        statuses = ', '.join(f'{k} {v}' for k, v in sorted(s['statuses'].items()))
+        print(f"{s['panels']:>6}  {float(s['plan']):6.1f}  {s['limit']:5g}  {len(lat):6}  "
+              f'{percentile(lat, 0.5):5.2f}  {percentile(lat, 0.95):5.2f}  {max(lat):5.2f}  '
+              f'{delay:10.2f}  {statuses}')
+    print("delay: re-planned makespan minus the plan's, in schedule units")
+
+
+def print_comparisons(rows, cold_limit):
+    print(f'\nre-plan vs cold solve ({cold_limit:g} s, no hint, no keep) of the same residual')
+    print('panels  robot      at      re-plan  moves  cold     bound    status    cold s  moves'
+          '  re-plan - cold')
+    for c in rows:
+        bound = float(c['cold_bound']) if c['cold_bound'] is not None else float('nan')
+        cold = float(c['cold']) if c['cold'] is not None else float('nan')
+        print(f"{c['panels']:>6}  {c['robot']:9}  {float(c['now']):6.1f}  "
+              f"{float(c['replan']):7.2f}  {c['replan_moves']:5}  {cold:7.2f}  {bound:7.2f}  "
+              f"{c['cold_status']:8}  {c['cold_seconds']:6.1f}  {c['cold_moves']:5}  "
+              f"{float(c['replan']) - cold:+.2f}")
+    print('moves: (job, robot) assignments of the re-planned jobs not in the previous plan')
+
+
+if __name__ == '__main__':
+    main()
