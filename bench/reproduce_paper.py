@@ -50,8 +50,9 @@ WARM = 'MIP SCIP, greedy start'
 
 # SCIP given two threads runs two concurrent searches that each get half the machine and
 # did worse here; HiGHS's branch and bound is serial too. CP-SAT uses both cores.
-FULL = {'limits': {1: 60.0, 2: 100.0}, 'cpsat_limits': {1: 60.0, 2: 60.0}, 'workers': 2,
-        'mip_workers': 1, 'warm_limit': 60.0, 'seeds': 20, 'episodes': (5_000, 20_000)}
+FULL = {'limits': {1: 60.0, 2: 90.0}, 'cpsat_limits': {1: 60.0, 2: 60.0}, 'workers': 2,
+        'mip_workers': 1, 'warm_limit': 60.0, 'seeds': 20,
+        'episodes': (5_000, 10_000, 20_000)}
 QUICK = {'limits': {1: 5.0, 2: 5.0}, 'cpsat_limits': {1: 5.0, 2: 5.0}, 'workers': 2,
          'mip_workers': 1, 'warm_limit': 5.0, 'seeds': 3, 'episodes': (500, 2_000)}
 
@@ -80,9 +81,12 @@ def native_stdout_to(path):
 
 
 def progress_scip(text):
-    """(seconds, incumbent) for every SCIP progress line that has an incumbent."""
+    """(seconds, incumbent or None, dual bound) for every SCIP progress line."""
     points, columns = [], None
     for line in text.splitlines():
+        given = re.search(r'given by solution candidate storage, new primal bound (\S+)', line)
+        if given:  # the warm start, accepted before the search starts
+            points.append((0.0, float(given.group(1)), None))
         cells = [c.strip() for c in line.split('|')]
         if len(cells) < 5:
             continue
@@ -91,10 +95,10 @@ def progress_scip(text):
             continue
         if columns is None or len(cells) != len(columns):
             continue
-        value = cells[columns.index('primalbound')]
         seconds = re.search(r'([0-9.]+)s$', cells[0])
-        if seconds and value not in ('--', '-'):
-            points.append((float(seconds.group(1)), float(value)))
+        if seconds:
+            points.append((float(seconds.group(1)), _float(cells[columns.index('primalbound')]),
+                           _float(cells[columns.index('dualbound')])))
     return points
 
 
@@ -106,29 +110,38 @@ def progress_highs(text):
         if not tokens or not re.fullmatch(r'[0-9.]+s', tokens[-1]) or not percent:
             continue
         i = percent[0]
-        if i + 2 >= len(tokens):
-            continue
-        try:
-            value = float(tokens[i + 2])
-        except ValueError:
-            continue
-        if np.isfinite(value):
-            points.append((float(tokens[-1][:-1]), value))
+        if i + 2 < len(tokens):
+            points.append((float(tokens[-1][:-1]), _float(tokens[i + 2]),
+                           _float(tokens[i + 1])))
     return points
 
 
 def progress_cpsat(text):
-    return [(float(m.group(1)), float(m.group(2))) for m in
+    return [(float(m.group(1)), float(m.group(2)), None) for m in
             re.finditer(r'^#\d+\s+([0-9.]+)s\s+best:([-0-9.e+]+)', text, re.MULTILINE)]
+
+
+def _float(cell):
+    try:
+        value = float(cell)
+    except ValueError:
+        return None
+    return value if np.isfinite(value) else None
 
 
 def milestones(points):
     """Seconds to the first incumbent and to the first occurrence of the final one."""
-    if not points:
+    found = [(t, v) for t, v, _ in points if v is not None]
+    if not found:
         return None, None
-    final = min(v for _, v in points)
-    best = next(t for t, v in points if v <= final + 0.5)
-    return points[0][0], best
+    final = min(v for _, v in found)
+    best = next(t for t, v in found if v <= final + 0.5)
+    return found[0][0], best
+
+
+def last_dual(points):
+    duals = [d for _, _, d in points if d is not None]
+    return duals[-1] if duals else None
 
 
 # ----- exact solvers ----------------------------------------------------------------------
@@ -146,13 +159,25 @@ def run_exact(problem, solver, limit, workers, scratch):
     text = log.read_text(errors='replace')
     parse = {'CP-SAT': progress_cpsat, 'MIP SCIP': progress_scip, WARM: progress_scip,
              'MIP HIGHS': progress_highs}[solver]
-    first, best = milestones(parse(text))
-    if solver == 'CP-SAT' and result.first_solution_seconds is not None:
+    points = parse(text)
+    first, best = milestones(points)
+    scale = re.search(r'scaled by (\d+)', ' '.join(result.notes))
+    log_bound = last_dual(points)
+    if log_bound is not None and scale:
+        log_bound /= int(scale.group(1))
+    if first is None and result.first_solution_seconds is not None:
         first = result.first_solution_seconds
     problems = None if result.schedule is None else validate(problem, result.schedule)
     return {'solver': solver, 'result': result, 'first': first, 'best': best,
             'proof': result.solve_seconds if result.status == Status.OPTIMAL else None,
-            'valid': problems == [], 'problems': problems, 'limit': limit}
+            'valid': problems == [], 'problems': problems, 'limit': limit,
+            'log_bound': log_bound}
+
+
+def bound_cell(bound, log_bound):
+    if bound is None and log_bound is not None:
+        return f'— (log: {log_bound:.2f})'
+    return number(bound)
 
 
 def verdict(problems):
@@ -241,13 +266,20 @@ def exact_section(runs, panels, config):
         '| gap | status | valid |',
         '|---|---|---|---|---|---|---|---|---|',
     ]
+    solved = [run for run in runs if run['valid']]
+    best = min((run['result'].makespan for run in solved), default=None)
+    proven = [run['solver'] for run in runs if run['result'].status == Status.OPTIMAL]
+    holders = ', '.join(run['solver'] for run in solved if run['result'].makespan == best)
+    summary = (f'Here: best makespan {number(best)}' + (f' ({holders})' if holders else '')
+               + f"; proven optimal by {', '.join(proven) or 'none within the limits'}.")
+    result_lines[3:3] = ['', summary]
     for run in runs:
         r = run['result']
         gap = '—' if r.gap is None else f'{100 * r.gap:.1f}%'
         result_lines.append(
             f"| {run['solver']} (limit {run['limit']:g} s) | {seconds(run['first'])} "
             f"| {seconds(run['best'])} | {seconds(run['proof'])} | {number(r.makespan)} "
-            f"| {number(r.lower_bound)} | {gap} | {r.status} "
+            f"| {bound_cell(r.lower_bound, run['log_bound'])} | {gap} | {r.status} "
             f'| {verdict(run["problems"])} |')
     return result_lines
 
@@ -266,10 +298,11 @@ def rl_section(results, optimum, optimum_schedule, problem, config):
                      f'| {number(optimum)} '
                      f"| {statistics.mean(r['seconds'] for r in rows):.1f} |")
     last = results[max(results)]
-    failures = Counter(r['violation'] for r in last if r['schedule'] is None)
-    if failures:
-        lines += ['', f'Why the greedy policy failed after {max(results)} episodes:', '']
-        lines += [f'- {n} seed(s): {reason}' for reason, n in failures.most_common()]
+    for episodes, rows in results.items():
+        failures = Counter(r['violation'] for r in rows if r['schedule'] is None)
+        if failures:
+            lines += ['', f'Why the greedy policy failed after {episodes} episodes:', '']
+            lines += [f'- {n} seed(s): {reason}' for reason, n in failures.most_common()]
     m2 = Counter(next(iter(r['schedule'].jobs['M2'].robots)) for r in last
                  if r['schedule'] is not None)
     if m2:
@@ -299,7 +332,8 @@ def write_report(config, exact, rl, optimum, optimum_schedule, subset, wall, qui
         'independent validator in exact arithmetic (column "valid"). HiGHS through OR-Tools '
         "9.15's `pywraplp` loses its incumbent when it stops at a time limit (status code 99, "
         'google/or-tools#5016 and #5372): its first/best times come from its log, but it '
-        'returns a schedule only if it finishes.',
+        'returns a schedule only if it finishes. Without a solution `pywraplp` returns no '
+        'bound either; "(log: x)" is then the last bound the solver printed.',
         '',
         '## MIP (§IV) and CP-SAT',
         '',
@@ -307,7 +341,7 @@ def write_report(config, exact, rl, optimum, optimum_schedule, subset, wall, qui
         '`src/fjsp_planner/fjsp_planner/core/mip.py`), solved through OR-Tools `pywraplp` '
         "with no warm start, times scaled to the exact 1/30 grid; for 2 panels also as "
         "`solve(solver='mip')` runs it, started from the greedy schedule (which also caps "
-        "its horizon). CP-SAT: the project's "
+        "its horizon; its first solution is that start). CP-SAT: the project's "
         'model (`core/cpsat.py`) through `solve()`, which warm-starts it from the greedy '
         'schedule. Gurobi 9 is not available here; its figures are quoted from the paper.',
         '',

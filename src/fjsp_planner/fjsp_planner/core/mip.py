@@ -329,20 +329,20 @@ class _Model:
         if code == pywraplp.Solver.INFEASIBLE:
             return Result(Status.INFEASIBLE, None, None, seconds, None, name, notes=self.notes)
         if not found:
+            # pywraplp reports no bound without a solution (SCIP's own is lost: BestBound()
+            # answers 0). OR-Tools 9.15 answers an undocumented code (99) when HiGHS stops at
+            # the time limit and drops its incumbent too (google/or-tools#5016, #5372).
             known = code in (pywraplp.Solver.NOT_SOLVED, pywraplp.Solver.ABNORMAL,
                              pywraplp.Solver.UNBOUNDED, pywraplp.Solver.MODEL_INVALID)
-            # OR-Tools 9.15 answers an undocumented code (99) when HiGHS stops at the time
-            # limit and drops its incumbent and bound with it (google/or-tools#5016, #5372).
             notes = self.notes if known else self.notes + (
-                f'the backend stopped with status code {code} and returned no solution or '
-                'bound (HiGHS at a time limit: OR-Tools 9.15 drops its incumbent)',)
-            return Result(Status.UNKNOWN, None, self._bound() if known else None, seconds,
-                          None, name, notes=notes)
+                f'the backend stopped with status code {code} and returned no solution '
+                '(HiGHS at a time limit: OR-Tools 9.15 drops its incumbent)',)
+            return Result(Status.UNKNOWN, None, None, seconds, None, name, notes=notes)
         schedule = self._schedule()
         bound = self._bound()
-        if code == pywraplp.Solver.OPTIMAL:
-            bound = schedule.makespan if bound is None else max(bound, schedule.makespan)
         bound = min(bound, schedule.makespan) if bound is not None else None
+        # Proven only when the bound, rounded up to the grid, meets the exact makespan; the
+        # backend's own verdict allows for its tolerances.
         status = Status.OPTIMAL if bound == schedule.makespan else Status.FEASIBLE
         return Result(status, schedule.makespan, bound, seconds, schedule, name,
                       notes=self.notes)
@@ -354,7 +354,8 @@ class _Model:
         if self.scale:
             # Every earliest-start makespan lies on the grid, so a bound rounds up to it.
             return Fraction(max(0, math.ceil(value - 1e-6)), self.scale)
-        return max(Fraction(0), Fraction(value).limit_denominator(10 ** 6))
+        # Without a grid, round down to a millionth so the bound stays a bound.
+        return max(Fraction(0), Fraction(math.floor((value - 1e-6) * 10 ** 6), 10 ** 6))
 
     def _schedule(self) -> Schedule:
         p = self.p
