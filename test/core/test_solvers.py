@@ -176,3 +176,27 @@ def test_keep_prefers_previous_assignments_at_equal_makespan():
 def test_unknown_solver_is_rejected():
     with pytest.raises(ValueError, match="unknown solver 'gurobi'"):
         solve(load_scenario(PAPER), solver='gurobi')
+
+
+def test_release_time_binds_after_a_running_job():
+    """r1 runs x until 2 but is released (re-planned) at 5: y, which only r1 can do, 5-6."""
+    problem = small([('r1', {0: 2, 1: 1})], [('x', ((0,),)), ('y', ((1,),))],
+                    fleet=(Robot('r1', 'r1', release_time=Fraction(5)),),
+                    fixed={'x': FixedJob(0, Fraction(0), Fraction(2), {'r1': 0})})
+    result = optimal(problem)
+    assert result.makespan == 6
+    early = result.schedule.__class__(
+        {**result.schedule.jobs, 'y': result.schedule.jobs['y'].__class__(
+            'y', 0, Fraction(2), Fraction(3), {'r1': 1})}, result.schedule.sequences)
+    assert any("job 'y' starts at 2 before its release time 5" in m
+               for m in validate(problem, early))
+
+
+def test_a_broken_hint_is_ignored_not_trusted():
+    problem = load_scenario(PAPER)
+    broken = greedy_schedule(problem)
+    broken = broken.__class__({j: a for j, a in broken.jobs.items() if j != 'Ad'},
+                              broken.sequences)
+    result = solve(problem, time_limit=10, hint=broken)
+    assert result.makespan == 32 and validate(problem, result.schedule) == []
+    assert any('hint is not a valid schedule' in note for note in result.notes)

@@ -21,7 +21,8 @@ from fjsp_planner.core.schedule import JobAssignment, Result, Schedule, Status
 
 MAX_SCALE = 1000
 KEEP_SHARE = 0.3
-"""Share of the time limit spent, after the makespan search, keeping previous assignments."""
+"""At most this share of the time limit goes, once the makespan is proven, to keeping
+previous assignments; an unproven makespan gets the whole limit."""
 
 
 def solve_cpsat(problem: Problem, time_limit=10.0, workers=2, hint: Schedule | None = None,
@@ -37,9 +38,8 @@ def solve_cpsat(problem: Problem, time_limit=10.0, workers=2, hint: Schedule | N
     if hint is not None or upper_bound is not None:
         model.add_hint(hint or upper_bound)
     model.model.minimize(model.makespan)
-    keep_time = time_limit * KEEP_SHARE if keep is not None else 0.0
     setup = time.monotonic() - began
-    solver, recorder, status = _run(model.model, time_limit - keep_time, workers, log)
+    solver, recorder, status = _run(model.model, time_limit, workers, log)
     if status in ('INFEASIBLE',):
         return Result(Status.INFEASIBLE, None, None, time.monotonic() - began, None, 'cpsat',
                       notes=model.notes)
@@ -51,9 +51,11 @@ def solve_cpsat(problem: Problem, time_limit=10.0, workers=2, hint: Schedule | N
     best = solver.value(model.makespan)
     bound = Fraction(math.ceil(solver.best_objective_bound), model.scale)
     schedule = model.read(solver)
-    if keep is not None and keep_time > 0:
-        schedule = _keep_assignments(model, solver, best, keep, keep_time, workers, log) \
-            or schedule
+    if keep is not None and status == 'OPTIMAL':
+        keep_time = min(time_limit * KEEP_SHARE, time_limit - solver.wall_time)
+        if keep_time > 0.01:
+            schedule = _keep_assignments(model, solver, best, keep, keep_time, workers,
+                                         log) or schedule
     proven = status == 'OPTIMAL'
     makespan = schedule.makespan
     lower_bound = min(bound, makespan) if model.exact else bound
@@ -159,8 +161,13 @@ class _Model:
         scale = math.lcm(*denominators) if denominators else 1
         if scale > MAX_SCALE:
             return MAX_SCALE, False
+        # Release and fixed times (wall-clock `now` when re-planning) join the grid while it
+        # stays small enough; beyond that they are rounded, which costs exactness, not validity.
         others = [r.release_time for r in p.robots]
         others += [t for f in p.fixed.values() for t in (f.start, f.end)]
+        finer = math.lcm(scale, *(v.denominator for v in others))
+        if finer <= MAX_SCALE:
+            return finer, True
         return scale, all((v * scale).denominator == 1 for v in others)
 
     def _horizon(self, upper_bound):
@@ -262,6 +269,11 @@ class _Model:
                     if robot.start_location is not None:
                         ready += p.travel(r, robot.start_location, p.job(a).location)
                     m.add(self.start[a] >= self.ticks(ready)).only_enforce_if(first)
+                    # After a fixed (running) job the route bounds the start only by that
+                    # job's end, which may lie before the release time.
+                    if robot.release_time > 0:
+                        m.add(self.start[a] >= self.ticks(robot.release_time)).only_enforce_if(
+                            on)
                 for b in jobs:
                     if a == b or b in ancestors[a] or (b in p.fixed and a not in p.fixed):
                         continue

@@ -94,7 +94,8 @@ class _State:
     def commit(self, assignment):
         self.jobs[assignment.job] = assignment
         for r in assignment.robots:
-            self.free[r] = assignment.end
+            # max: a running (fixed) job may end before its robot's release time.
+            self.free[r] = max(self.free[r], assignment.end)
             self.where[r] = self.problem.job(assignment.job).location
             self.sequences[r].append(assignment.job)
             if self.reserved.get(r) == assignment.job:

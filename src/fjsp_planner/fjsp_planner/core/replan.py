@@ -130,9 +130,8 @@ def _solve(residual: Problem, previous: Schedule, time_limit, workers) -> Result
     A previous plan broken by the failure is a poor start: CP-SAT repairing its stale parts
     can take longer than finding a schedule afresh from the greedy one.
     """
-    projected = _project(residual, previous)
-    hint = projected if projected is not None and not validate(residual, projected) else None
-    return solve(residual, time_limit=time_limit, workers=workers, hint=hint, keep=previous)
+    return solve(residual, time_limit=time_limit, workers=workers,
+                 hint=_project(residual, previous), keep=previous)
 
 
 def _project(residual: Problem, previous: Schedule) -> Schedule | None:

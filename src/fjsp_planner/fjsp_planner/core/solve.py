@@ -8,6 +8,7 @@ from fjsp_planner.core.cpsat import solve_cpsat
 from fjsp_planner.core.greedy import GreedyStuckError, greedy_schedule
 from fjsp_planner.core.problem import Problem
 from fjsp_planner.core.schedule import Result, Schedule, Status
+from fjsp_planner.core.validate import validate
 
 SOLVERS = ('cpsat', 'greedy', 'mip')
 
@@ -17,18 +18,25 @@ def solve(problem: Problem, solver: str = 'cpsat', time_limit: float = 10.0, wor
           mip_backend: str = 'SCIP', log: bool = False) -> Result:
     """Minimise the makespan of `problem`.
 
-    `hint` warm-starts the search with whatever of it still fits the problem; `keep` (CP-SAT
-    only) then prefers, among schedules of the best makespan found, those that change the
+    `hint` warm-starts the search if it is a valid schedule of `problem`; `keep` (CP-SAT
+    only) then prefers, among schedules of the proven best makespan, those that change the
     fewest of its (job, robot) assignments. The greedy schedule bounds the horizon and is
     returned when an exact solver finds nothing in time.
     """
     if solver not in SOLVERS:
         raise ValueError(f"unknown solver '{solver}'; choose one of {', '.join(SOLVERS)}")
     began = time.monotonic()
+    notes = ()
+    if hint is not None and validate(problem, hint):
+        # Repairing a broken hint can cost CP-SAT more than starting from the greedy one.
+        hint, notes = None, ('the hint is not a valid schedule of this problem; ignored',)
     try:
         greedy = greedy_schedule(problem)
     except GreedyStuckError:
         greedy = None
+    if greedy is not None and validate(problem, greedy):
+        # Its makespan would cap the horizon; an invalid one could make CP-SAT miss schedules.
+        greedy, notes = None, notes + ('the greedy schedule was invalid; not used',)
     if solver == 'greedy':
         if greedy is None:
             return Result(Status.UNKNOWN, None, None, time.monotonic() - began, None, 'greedy',
@@ -53,7 +61,7 @@ def solve(problem: Problem, solver: str = 'cpsat', time_limit: float = 10.0, wor
                       best_solution_seconds=setup,
                       notes=result.notes + (f'{result.solver} found no schedule in '
                                             f'{time_limit:g} s; greedy schedule returned',))
-    return _count_from(problem, result, setup)
+    return _count_from(problem, dataclasses.replace(result, notes=notes + result.notes), setup)
 
 
 def _count_from(problem: Problem, result: Result, setup: float) -> Result:

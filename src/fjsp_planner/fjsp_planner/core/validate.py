@@ -108,6 +108,10 @@ def _sequences(problem: Problem, schedule: Schedule,
         timed = [j for j in sequence if j in known]
         if timed and timed[0] not in problem.fixed:
             messages += _first_job(problem, robot, timed[0], known[timed[0]])
+        for job in timed[1:]:
+            if job not in problem.fixed and known[job].start < robot.release_time:
+                messages.append(f"robot '{name}': job '{job}' starts at {known[job].start} "
+                                f'before its release time {robot.release_time}')
         for prev, nxt in zip(timed, timed[1:], strict=False):
             start, end = known[nxt].start, known[prev].end
             if start < end:
