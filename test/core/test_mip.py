@@ -6,13 +6,13 @@ import pytest
 
 from fjsp_planner.core.greedy import greedy_schedule
 from fjsp_planner.core.mip import solve_mip
-from fjsp_planner.core.problem import Job, Problem, Robot
+from fjsp_planner.core.problem import FixedJob, Job, Problem, Robot
 from fjsp_planner.core.schedule import Status
 from fjsp_planner.core.validate import validate
 
 
 def problem(jobs, robots=(('R1', 1), ('R2', 3)), precedence=(), holding=(), distance=None,
-            start=None):
+            start=None, fixed=None):
     """Robots ('name', hold time) with travel efficiency 1; jobs at locations x and y."""
     types = {name: {0: Fraction(t), 1: Fraction(1)} for name, t in robots}
     fleet = [Robot(name, name, Fraction(1)) for name, _ in robots]
@@ -22,7 +22,7 @@ def problem(jobs, robots=(('R1', 1), ('R2', 3)), precedence=(), holding=(), dist
         operation_types={0: 'hold', 1: 'locomote'}, robot_types=types, robots=tuple(fleet),
         jobs=tuple(Job(name, where, plans) for name, where, plans in jobs),
         distances={('x', 'y'): Fraction(distance or 0), ('y', 'x'): Fraction(distance or 0)},
-        precedence=tuple(precedence), holding=tuple(holding), locomote=1)
+        precedence=tuple(precedence), holding=tuple(holding), locomote=1, fixed=fixed or {})
 
 
 def solved(p, backend='SCIP', hint=None):
@@ -81,6 +81,17 @@ def test_start_location_and_release_time_delay_the_first_job():
     result = solved(p)
     assert result.makespan == Fraction(13, 2)  # released at 2, 7/2 travel, 1 work
     assert result.schedule.jobs['a'].start == Fraction(11, 2)
+
+
+def test_a_running_job_stays_and_release_binds_the_next_job():
+    # R1 is on a (running, [0, 1]) but only released at 3 (say, it reports back then).
+    p = problem([('a', 'x', ((0,),)), ('b', 'x', ((0,),))], robots=(('R1', 1),),
+                start=(None, Fraction(3)),
+                fixed={'a': FixedJob(0, Fraction(0), Fraction(1), {'R1': 0})})
+    result = solved(p)
+    assert result.schedule.jobs['a'].start == 0
+    assert result.schedule.jobs['b'].start == 3
+    assert result.makespan == 4
 
 
 @pytest.mark.parametrize('backend', ['SCIP', 'HIGHS'])

@@ -2,7 +2,8 @@
 
 Each seeded instance has 3-5 jobs, 2-3 robots with rational speeds, multi-robot jobs,
 alternative plans, one holding arc and travel between three locations; some add a robot
-with a start location and release time, or a job already running (fixed).
+with a start location and release time, or a job already running (fixed), maybe with one of
+its robots released only after it ends.
 """
 
 import random
@@ -71,6 +72,8 @@ def _draw(rng: random.Random, seed: int) -> Problem:
              and n not in (names[a], names[b])]
     if roots and rng.random() < 0.3:
         fixed = _running(rng, roots[0], jobs, robots, robot_types)
+        if fixed and rng.random() < 0.5:
+            robots = _late_release(rng, robots, fixed)
 
     return Problem(
         operation_types={0: 'hold', 1: 'carry', 2: 'weld', LOCOMOTE: 'locomote'},
@@ -94,6 +97,14 @@ def _running(rng, name, jobs, robots, robot_types):
         staff[robot.name] = q
         longest = max(longest, robot_types[robot.type][q])
     return {name: FixedJob(0, Fraction(0), longest + 1, staff)}
+
+
+def _late_release(rng, robots, fixed):
+    """Release one robot of the running job after it ends (it reports back late)."""
+    (job,) = fixed.values()
+    late = rng.choice(sorted(job.robots))
+    return [Robot(r.name, r.type, r.speed, r.start_location, job.end + rng.randint(1, 3))
+            if r.name == late else r for r in robots]
 
 
 SEEDS = range(20)
@@ -128,6 +139,8 @@ def test_generator_covers_the_features():
     assert any(p.fixed for p in problems)
     assert any(r.start_location for p in problems for r in p.robots)
     assert any(r.release_time > 0 for p in problems for r in p.robots)
+    assert any(r.release_time > f.end for p in problems for f in p.fixed.values()
+               for r in p.robots if r.name in f.robots)
     assert any(p.travel(r.name, a, b).denominator > 1 for p in problems for r in p.robots
                for a in LOCATIONS for b in LOCATIONS)
 

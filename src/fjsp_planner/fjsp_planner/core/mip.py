@@ -24,9 +24,10 @@ Where the printed model slips, this module implements the evident intent:
    `x_jj'm >= Σ_p Σ_{o: type q} x_jpom  ∀ m, (j, j', q) ∈ H` (no arc variable: no holder m).
 
 Extensions of SPEC §1 the paper does not print: a robot with a start location travels from it
-to its first job, and no robot starts before its release time; a fixed (already running) job
-keeps its plan, robots and times and is the first job of its robots. Arcs j -> j' with j' a
-precedence ancestor of j cannot be used and are not created.
+to its first job, and no robot starts a new job before its release time (a robot released
+after the running job it is on ends cannot start its next job before then); a fixed (already
+running) job keeps its plan, robots and times and is the first job of its robots. Arcs
+j -> j' with j' a precedence ancestor of j cannot be used and are not created.
 
 Durations are rational. Every time is scaled by the LCM of the denominators so the model has
 integer data and its bound can be rounded up to the grid. The schedule itself is rebuilt in
@@ -239,6 +240,7 @@ class _Model:
             s.Add(x == self.x_first[j, m] + s.Sum(self.arcs_in[j, m]))
             if j not in fixed:
                 s.Add(self.start[j] >= self._num(self.ready[m, j]) * self.x_first[j, m])
+                s.Add(self.start[j] >= self._num(self.p.robot(m).release_time) * x)
         for m in self.robots:
             s.Add(s.Sum(self.x_first[j, m] for j in self.jobs if (j, m) in self.x_first) <= 1)
             s.Add(s.Sum(self.x_last[j, m] for j in self.jobs if (j, m) in self.x_last) <= 1)
@@ -390,8 +392,8 @@ def earliest_schedule(problem: Problem, plan, robots, sequences) -> Schedule:
     """The earliest-start schedule, in exact time, of given plans, robots and robot sequences.
 
     A job starts when its predecessors are complete and each of its robots has finished its
-    previous job and travelled over (or, for its first job, is released and has come from its
-    start location); it completes when its slowest operation ends. Fixed jobs keep their times.
+    previous job and travelled over (or, for its first job, has come from its start location)
+    and is released; it completes when its slowest operation ends. Fixed jobs keep their times.
     """
     p = problem
     blockers = {j.name: set() for j in p.jobs}
@@ -418,6 +420,7 @@ def earliest_schedule(problem: Problem, plan, robots, sequences) -> Schedule:
                 times.append(r.release_time + leg)
             else:
                 times.append(end[before] + p.travel(m, p.job(before).location, here))
+                times.append(p.robot(m).release_time)
         start[j] = max(times, default=Fraction(0))
         end[j] = start[j] + max(p.duration(m, q) for m, q in robots[j].items())
     jobs = {j: JobAssignment(j, plan[j], start[j], end[j], dict(robots[j])) for j in order}
