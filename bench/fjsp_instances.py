@@ -3,7 +3,8 @@
     python bench/fjsp_instances.py DIR [--time-limit S] [--solver cpsat|mip-scip|mip-highs]
 
 Prints one row per instance: benchmark jobs, operations, machines, makespan, lower bound,
-gap, status and wall time. Every schedule is checked by the independent validator.
+gap, status and wall time. Solves go through `solve()` (greedy start and fallback); every
+schedule is checked by the independent validator.
 """
 
 import argparse
@@ -15,21 +16,20 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / 'src' / 'fjsp_planner'))
 
 from fjsp_planner.core.fjs import load_fjs  # noqa: E402
-from fjsp_planner.core.mip import solve_mip  # noqa: E402
 from fjsp_planner.core.problem import ProblemError  # noqa: E402
 from fjsp_planner.core.solve import solve  # noqa: E402
 from fjsp_planner.core.validate import validate  # noqa: E402
 
 SOLVERS = ('cpsat', 'mip-scip', 'mip-highs')
 COLUMNS = ('instance', 'jobs', 'ops', 'machines', 'makespan', 'bound', 'gap', 'status',
-           'seconds')
+           'by', 'seconds')
+"""`by` names the solver whose schedule it is: `greedy` when the exact one found none."""
 
 
 def run(problem, solver, time_limit, workers):
-    if solver == 'cpsat':
-        return solve(problem, solver='cpsat', time_limit=time_limit, workers=workers)
-    return solve_mip(problem, time_limit=time_limit, backend=solver.split('-')[1].upper(),
-                     workers=workers)
+    name, _, backend = solver.partition('-')
+    return solve(problem, solver=name, time_limit=time_limit, workers=workers,
+                 mip_backend=backend.upper() or 'SCIP')
 
 
 def number(value):
@@ -69,7 +69,7 @@ def main(argv=None) -> int:
         gap = '-' if result.gap is None else f'{100 * result.gap:.1f}%'
         rows.append((path.stem, str(jobs), str(len(problem.jobs)), str(len(problem.robots)),
                      number(result.makespan), number(result.lower_bound), gap,
-                     str(result.status), f'{seconds:.1f}'))
+                     str(result.status), result.solver, f'{seconds:.1f}'))
     widths = [max(len(c), *(len(r[i]) for r in rows)) if rows else len(c)
               for i, c in enumerate(COLUMNS)]
     print(f'# solver {args.solver}, time limit {args.time_limit:g} s, {args.workers} workers')
