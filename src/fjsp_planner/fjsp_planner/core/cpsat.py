@@ -137,7 +137,11 @@ class _Model:
         """(robot, first panel, last panel) when mirrored panels are cut off."""
         self.duration, self.used, self.first_arc, self.last_arc = {}, {}, {}, {}
         self.panel_visits, self.crossings = {}, {}
+        self.busy = {}
+        """robot -> its optional job intervals, which must not overlap."""
         self._jobs()
+        for intervals in self.busy.values():
+            self.model.add_no_overlap(intervals)
         self._precedence()
         self._routes()
         self._holding()
@@ -224,7 +228,8 @@ class _Model:
                 m.add(on == sum(lit for lit, _ in mine))
                 self.on_job[name, r] = on
                 longest.append(sum(lit * self.ticks(p.duration(r, q)) for lit, q in mine))
-                m.new_optional_interval_var(start, duration, end, on, f'busy_{name}_{r}')
+                self.busy.setdefault(r, []).append(
+                    m.new_optional_interval_var(start, duration, end, on, f'busy_{name}_{r}'))
             if fixed is None:
                 m.add_max_equality(duration, longest)
 
@@ -245,13 +250,23 @@ class _Model:
         return before
 
     def _routes(self):
+        """A circuit per robot, needed only when travel or holding makes order matter beyond
+        no-overlap (classic FJSP instances have neither, and are much faster without)."""
         p, m = self.problem, self.model
         ancestors = self._ancestors()
+        self.routed = bool(p.holding) or any(leg > 0 for leg in self.legs.values())
         for robot in p.robots:
             r = robot.name
             jobs = [j.name for j in p.jobs if (j.name, r) in self.on_job]
             self.route_nodes[r] = jobs
             if not jobs:
+                continue
+            if not self.routed:
+                if robot.release_time > 0:
+                    for a in jobs:
+                        if a not in p.fixed:
+                            m.add(self.start[a] >= self.ticks(robot.release_time)
+                                  ).only_enforce_if(self.on_job[a, r])
                 continue
             node = {name: i + 1 for i, name in enumerate(jobs)}
             used = self.used[r] = m.new_bool_var(f'used_{r}')
@@ -384,12 +399,13 @@ class _Model:
             successor = dict(zip(route, route[1:], strict=False))
             for j in jobs:
                 m.add_hint(self.on_job[j, r], int(j in route))
-                m.add_hint(self.first_arc[j, r], int(bool(route) and route[0] == j))
-                m.add_hint(self.last_arc[j, r], int(bool(route) and route[-1] == j))
-            for (a, b, robot), arc in self.arcs.items():
-                if robot == r:
-                    m.add_hint(arc, int(successor.get(a) == b))
-            if jobs:
+            if r in self.used:
+                for j in jobs:
+                    m.add_hint(self.first_arc[j, r], int(bool(route) and route[0] == j))
+                    m.add_hint(self.last_arc[j, r], int(bool(route) and route[-1] == j))
+                for (a, b, robot), arc in self.arcs.items():
+                    if robot == r:
+                        m.add_hint(arc, int(successor.get(a) == b))
                 m.add_hint(self.used[r], int(bool(route)))
             if r in self.panel_visits:
                 panel_of = {j: k for k, names in enumerate(p.panels) for j in names}
@@ -420,6 +436,9 @@ class _Model:
         sequences = {}
         for r in self.robots:
             mine = [j for j in self.route_nodes[r] if r in jobs[j].robots]
+            if not self.routed:
+                sequences[r] = tuple(sorted(mine, key=lambda j: (jobs[j].start, jobs[j].end)))
+                continue
             successor = {a: b for (a, b, robot), arc in self.arcs.items()
                          if robot == r and solver.value(arc)}
             first = [j for j in mine if not any(successor.get(o) == j for o in mine)]
