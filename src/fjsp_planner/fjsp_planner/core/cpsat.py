@@ -237,23 +237,11 @@ class _Model:
         for a, b in self.problem.precedence:
             self.model.add(self.start[b] >= self.end[a])
 
-    def _ancestors(self):
-        before = {j.name: set() for j in self.problem.jobs}
-        arcs = list(self.problem.precedence) + [(a, b) for a, b, _ in self.problem.holding]
-        changed = True
-        while changed:
-            changed = False
-            for a, b in arcs:
-                grown = before[b] | before[a] | {a}
-                if grown != before[b]:
-                    before[b], changed = grown, True
-        return before
-
     def _routes(self):
         """A circuit per robot, needed only when travel or holding makes order matter beyond
         no-overlap (classic FJSP instances have neither, and are much faster without)."""
         p, m = self.problem, self.model
-        ancestors = self._ancestors()
+        ancestors = p.ancestors()
         self.routed = bool(p.holding) or any(leg > 0 for leg in self.legs.values())
         for robot in p.robots:
             r = robot.name

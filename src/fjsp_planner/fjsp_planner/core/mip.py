@@ -185,7 +185,7 @@ class _Model:
             able[j].add(m)
         self.able = able
         self.x_on = {(j, m): s.BoolVar(f'x_{j}_{m}') for j in self.jobs for m in able[j]}
-        ancestors = self._ancestors()
+        ancestors = self.p.ancestors()
         self.x_arc = {(a, b, m): s.BoolVar(f'x_{a}_{b}_{m}')
                       for m in self.robots for a in self.jobs for b in self.jobs
                       if a != b and m in able[a] and m in able[b] and b not in ancestors[a]}
@@ -199,19 +199,6 @@ class _Model:
             self.arcs_in[b, m].append(x)
         self.x_first = {(j, m): s.BoolVar(f'xstart_{j}_{m}') for (j, m) in self.x_on}
         self.x_last = {(j, m): s.BoolVar(f'xend_{j}_{m}') for (j, m) in self.x_on}
-
-    def _ancestors(self):
-        before = {j: set() for j in self.jobs}
-        arcs = list(self.p.precedence) + [(a, b) for a, b, _ in self.p.holding]
-        changed = True
-        while changed:
-            changed = False
-            for a, b in arcs:
-                grown = before[b] | before[a] | {a}
-                if grown != before[b]:
-                    before[b] = grown
-                    changed = True
-        return before
 
     def _constraints(self):
         s, p = self.solver, self.p

@@ -117,6 +117,19 @@ class Problem:
     def predecessors(self, job: str) -> list[str]:
         return [a for a, b in self.precedence if b == job]
 
+    def ancestors(self) -> dict[str, set[str]]:
+        """job -> every job that must complete before it starts (holding arcs order too)."""
+        before = {j.name: set() for j in self.jobs}
+        arcs = list(self.precedence) + [(a, b) for a, b, _ in self.holding]
+        changed = True
+        while changed:
+            changed = False
+            for a, b in arcs:
+                grown = before[b] | before[a] | {a}
+                if grown != before[b]:
+                    before[b], changed = grown, True
+        return before
+
 
 def _structural_problems(p: Problem) -> list[str]:
     """Every inconsistency of ids and numbers, each naming what is wrong."""
