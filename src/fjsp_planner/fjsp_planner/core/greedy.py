@@ -14,6 +14,8 @@ from fjsp_planner.core.problem import Problem
 from fjsp_planner.core.schedule import JobAssignment, Schedule
 
 MAX_CANDIDATES_PER_PLAN = 2000
+CHAIN_CANDIDATES = 12
+"""Staffings of a jig job tried, best first, when placing it with the jobs it holds into."""
 
 
 class GreedyStuckError(RuntimeError):
@@ -189,18 +191,28 @@ def _block_option(state: _State, name):
     if name in state.held_from:
         _, q = state.held_from[name]
         forced = {r: q for r, target in state.reserved.items() if target == name}
-    for end, start, plan, robots in state.candidates(name, ready, forced):
-        placements = _place_chain(state, chain, plan, start, robots)
-        if placements is not None:
-            return (end, placements)
-    return None
+    candidates = state.candidates(name, ready, forced)
+    if len(chain) == 1:
+        if not candidates:
+            return None
+        end, start, plan, robots = candidates[0]
+        return (end, [(name, plan, start, robots)])
+    # The jig job's staffing decides who must also do the held job, so judge each staffing
+    # by when the whole chain completes, not by when the jig job does.
+    best = None
+    for _, start, plan, robots in candidates[:CHAIN_CANDIDATES]:
+        placed = _place_chain(state, chain, plan, start, robots)
+        if placed is not None and (best is None or placed[0] < best[0]):
+            best = placed
+    return best
 
 
 def _place_chain(state: _State, chain, plan, start, robots):
-    """Try the chain's first job with this staffing and the rest greedily after it."""
+    """(end of the chain, placements) with the first job staffed so, the rest greedily."""
     trial = state.copy()
     trial.place(chain[0], plan, start, robots)
     placements = [(chain[0], plan, start, robots)]
+    end = None
     for member in chain[1:]:
         _, q = trial.held_from[member]
         forced = {r: q for r, target in trial.reserved.items() if target == member}
@@ -210,4 +222,4 @@ def _place_chain(state: _State, chain, plan, start, robots):
         end, member_start, member_plan, member_robots = options[0]
         trial.place(member, member_plan, member_start, member_robots)
         placements.append((member, member_plan, member_start, member_robots))
-    return placements
+    return end, placements
