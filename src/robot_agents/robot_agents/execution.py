@@ -167,6 +167,9 @@ class RobotExecution:
         tasks = tuple(tasks)
         events = []
         current = self.task
+        if self.revision == 0:
+            # A robot that joins a running mission cannot have done anything before it did.
+            self._free_at = max(self._free_at, now)
         self.revision = revision
         self._job_robots = {job: frozenset(robots) for job, robots in job_robots.items()}
         jobs = [t.job for t in tasks]

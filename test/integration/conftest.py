@@ -1,0 +1,27 @@
+"""Fixtures of the integration tests; the harness itself is in harness.py."""
+
+import pytest
+from harness import Launcher, Observer, new_domain
+
+
+@pytest.fixture
+def domain():
+    return new_domain()
+
+
+@pytest.fixture
+def launcher(domain, tmp_path):
+    launcher = Launcher(domain, tmp_path)
+    try:
+        yield launcher
+    finally:
+        launcher.stop()
+
+
+@pytest.fixture
+def observer(domain):
+    observer = Observer(domain)
+    try:
+        yield observer
+    finally:
+        observer.close()

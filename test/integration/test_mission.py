@@ -1,0 +1,109 @@
+"""A whole mission over real processes: planner + the paper's four robots, via `ros2 run`."""
+
+from collections import defaultdict
+from fractions import Fraction
+
+import pytest
+from harness import ROBOTS, SCENARIO, Launcher, Observer, new_domain
+
+from fjsp_msgs.msg import MissionStatus, TaskEvent
+from fjsp_planner.core.scenario import load_scenario
+from fjsp_planner.core.schedule import JobAssignment, Schedule
+from fjsp_planner.core.validate import validate
+
+MAKESPAN_TOLERANCE = 0.01
+"""Executed makespan may exceed the plan by 1 %: agents keep logical time, so the only slack
+is the rounding-up of reported ends (1e-6 units per leg or operation)."""
+
+
+def executed_timeline(problem, plans, events) -> Schedule:
+    """The schedule the robots actually ran, rebuilt from their task events alone."""
+    started, operation_done = defaultdict(dict), defaultdict(dict)
+    for e in events:
+        if e.kind == TaskEvent.KIND_STARTED:
+            started[e.job][e.robot] = e.time
+        elif e.kind == TaskEvent.KIND_OPERATION_DONE:
+            operation_done[e.job][e.robot] = e.time
+    tasks = {(r.robot, t.job): t for r in plans[-1].robots for t in r.tasks}
+    jobs = {}
+    for job, robots in started.items():
+        ops = {robot: tasks[robot, job].operation_type for robot in robots}
+        plan = tasks[next(iter(robots)), job].process_plan
+        end = max(operation_done[job].values())
+        jobs[job] = JobAssignment(job, plan, Fraction(min(robots.values())), Fraction(end), ops)
+    sequences = {r.name: tuple(sorted((j for j, a in jobs.items() if r.name in a.robots),
+                                      key=lambda j: jobs[j].start))
+                 for r in problem.robots}
+    return Schedule(jobs, sequences)
+
+
+@pytest.fixture(scope='module')
+def mission(tmp_path_factory):
+    """One mission shared by this module's tests (each check reads the same run)."""
+    domain = new_domain()
+    launcher = Launcher(domain, tmp_path_factory.mktemp('mission'))
+    observer = Observer(domain)
+    try:
+        launcher.start_planner()
+        for robot, _ in ROBOTS:
+            launcher.start_agent(robot)
+        observer.wait_for(lambda o: o.complete(), 60, 'the mission to complete')
+        # The last job-done event and the status saying complete may land in either order.
+        observer.wait_for(lambda o: sum(e.kind == TaskEvent.KIND_JOB_DONE
+                                        for e in o.events) >= 12, 5, 'every job-done event')
+        yield launcher, observer
+    finally:
+        launcher.stop()
+        observer.close()
+
+
+def test_every_job_is_done_exactly_once(mission):
+    _, observer = mission
+    done = [e.job for e in observer.events if e.kind == TaskEvent.KIND_JOB_DONE]
+    problem = load_scenario(SCENARIO)
+    assert sorted(done) == sorted(j.name for j in problem.jobs)
+    status = observer.status
+    assert (status.jobs_done, status.jobs_total, status.jobs_running) == (12, 12, 0)
+    assert status.ignored_stale + status.ignored_duplicate + status.ignored_unknown == 0
+    ids = [e.event_id for e in observer.events]
+    assert len(ids) == len(set(ids))
+
+
+def test_executed_timeline_respects_the_problem(mission):
+    _, observer = mission
+    problem = load_scenario(SCENARIO)
+    executed = executed_timeline(problem, observer.plans, observer.events)
+    assert validate(problem, executed) == []
+    plan = observer.plans[-1]
+    # Every robot of a job starts it at the same schedule time, and as planned: one robot each.
+    for job in executed.jobs:
+        starts = {e.robot: e.time for e in observer.events
+                  if e.kind == TaskEvent.KIND_STARTED and e.job == job}
+        planned = {r.robot for r in plan.robots for t in r.tasks if t.job == job}
+        assert set(starts) == planned, job
+        assert len(set(starts.values())) == 1, (job, starts)
+    for before, after in problem.precedence:
+        assert executed.jobs[after].start >= executed.jobs[before].end, (before, after)
+    for held_from, held_to, q in problem.holding:
+        holders = {r for r, op in executed.jobs[held_from].robots.items() if op == q}
+        assert holders, held_from
+        for robot in holders:
+            assert executed.jobs[held_to].robots.get(robot) == q, (robot, held_to)
+            sequence = executed.sequences[robot]
+            assert sequence.index(held_to) == sequence.index(held_from) + 1, (robot, sequence)
+    assert float(executed.makespan) <= plan.makespan * (1 + MAKESPAN_TOLERANCE)
+    assert float(executed.makespan) >= plan.makespan - 1e-9
+    assert observer.status.projected_makespan == pytest.approx(float(executed.makespan),
+                                                               abs=1e-6)
+
+
+def test_nodes_exit_cleanly_on_interrupt(mission):
+    launcher, observer = mission
+    assert observer.status.state == MissionStatus.STATE_COMPLETE
+    codes = launcher.stop()
+    # After a solve, CP-SAT's catch_sigint_signal has left SIGINT at its default action, so
+    # the planner dies of the signal (-2) instead of shutting down; it must not hang.
+    assert codes.pop('planner') in (0, -2)
+    assert codes == {name: 0 for name in codes}, codes
+    for name in codes:
+        assert 'Traceback' not in launcher.log(name), name
