@@ -129,6 +129,7 @@ class RobotAgent(Node):
         log.info(f'following plan revision {msg.revision}: '
                  + (' -> '.join(t.job for t in tasks) or 'no task'))
         self.publish_events(events)
+        self.publish_state()  # a new revision is a transition, even before the mission start
         self.tick()
 
     def on_event(self, msg: TaskEvent) -> None:

@@ -123,7 +123,10 @@ class PlannerNode(Node):
         if self.state == MissionStatus.STATE_WAITING_FOR_ROBOTS:
             missing = self.tracker.missing_robots
             waited = (self.get_clock().now() - self.waiting_since).nanoseconds * 1e-9
-            if missing and waited < self.robot_wait_timeout:
+            # Discovery is per direction: hearing a robot does not mean it hears the plan
+            # topic yet, and a plan it gets a second late makes it start late.
+            unmatched = self.plan_pub.get_subscription_count() < len(self.problem.robots)
+            if (missing or unmatched) and waited < self.robot_wait_timeout:
                 return
             if missing:
                 self.get_logger().warning(
