@@ -93,3 +93,13 @@ def test_duplicates_are_ignored(planned):
     assert tracker.record_event('b', EventKind.STARTED, robot, 'M1', 1, 0.0).ignored \
         == Ignored.DUPLICATE
     assert tracker.jobs['M1'].start == Fraction(0)
+
+
+def test_unknown_robot_heartbeats_count_once(planned):
+    problem, _ = planned
+    tracker = MissionTracker(problem)
+    first = tracker.record_robot_state('R2D2', 'idle', '', '', 0.0)
+    again = tracker.record_robot_state('R2D2', 'idle', '', '', 0.0)
+    assert first.ignored == again.ignored == Ignored.UNKNOWN
+    assert (first.repeated, again.repeated) == (False, True)
+    assert tracker.ignored[Ignored.UNKNOWN] == 1

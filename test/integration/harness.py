@@ -161,7 +161,8 @@ class Observer:
         """Wait until predicate(self) holds; fail naming `what` after `timeout` seconds."""
         with self.lock:
             if not self.lock.wait_for(lambda: predicate(self), timeout=timeout):
-                pytest.fail(f'timed out after {timeout:g} s waiting for {what}')
+                pytest.fail(f'timed out after {timeout:g} s waiting for {what}; last mission '
+                            f'status: {self.status}')
 
     def publisher(self, msg_type, topic, qos):
         return self.node.create_publisher(msg_type, topic, qos)

@@ -1,6 +1,7 @@
 """Stale revisions, duplicated events and unknown names are ignored, logged and counted."""
 
 import copy
+import time
 
 from harness import ROBOTS
 
@@ -19,13 +20,18 @@ def test_bad_messages_are_ignored_and_counted(launcher, observer):
     launcher.start_planner(time_scale=0.15)
     for robot, _ in ROBOTS:
         launcher.start_agent(robot)
-    observer.wait_for(lambda o: any(e.kind == TaskEvent.KIND_JOB_DONE for e in o.events), 30,
-                      'the first job to complete')
+    # Each writer is discovered on its own: the planner's job-done may come before any
+    # agent's event, so wait for both kinds.
+    observer.wait_for(lambda o: {TaskEvent.KIND_JOB_DONE, TaskEvent.KIND_STARTED}
+                      <= {e.kind for e in o.events}, 30, 'the first job to start and complete')
     plans = observer.publisher(Plan, PLAN_TOPIC, LATCHED_QOS)
     events = observer.publisher(TaskEvent, TASK_EVENTS_TOPIC, EVENTS_QOS)
     states = observer.publisher(RobotState, ROBOT_STATES_TOPIC, LATCHED_QOS)
-    observer.wait_for(lambda o: plans.get_subscription_count() >= 5
-                      and events.get_subscription_count() >= 5, 10,
+    # Subscribers: planner, four agents and this observer (plan, events); planner and
+    # observer (states). Latched writers would deliver late anyway, but within the wait.
+    observer.wait_for(lambda o: plans.get_subscription_count() >= 6
+                      and events.get_subscription_count() >= 6
+                      and states.get_subscription_count() >= 2, 15,
                       'the nodes to discover the test publishers')
 
     stale = copy.deepcopy(observer.plans[-1])
@@ -38,11 +44,14 @@ def test_bad_messages_are_ignored_and_counted(launcher, observer):
                              robot='R2D2', job='M1', plan_revision=1, time=1.0))
     events.publish(TaskEvent(event_id='MARC1/Zz/started/1', kind=TaskEvent.KIND_STARTED,
                              robot='MARC1', job='Zz', plan_revision=1, time=1.0))
-    states.publish(RobotState(robot='R2D2', mode=RobotState.MODE_IDLE))
+    # Robot states are heartbeats: publish a few, as a robot would; counted once per robot.
+    for _ in range(10):
+        states.publish(RobotState(robot='R2D2', mode=RobotState.MODE_IDLE))
+        time.sleep(0.2)
 
     observer.wait_for(lambda o: o.status.ignored_stale >= 1 and o.status.ignored_duplicate >= 1
-                      and o.status.ignored_unknown >= 3, 10,
-                      'the planner to count the ignored messages')
+                      and o.status.ignored_unknown >= 3, 15,
+                      'the planner to count 1 stale, 1 duplicate and 3 unknown messages')
     observer.wait_for(lambda o: o.complete(), 60, 'the mission to complete anyway')
     status = observer.status
     assert (status.ignored_stale, status.ignored_duplicate, status.ignored_unknown) == (1, 1, 3)

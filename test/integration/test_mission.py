@@ -51,6 +51,11 @@ def mission(tmp_path_factory):
         # The last job-done event and the status saying complete may land in either order.
         observer.wait_for(lambda o: sum(e.kind == TaskEvent.KIND_JOB_DONE
                                         for e in o.events) >= 12, 5, 'every job-done event')
+        # Each agent's event history reaches this observer when its writer is discovered.
+        parts = {(r.robot, t.job) for r in observer.plans[-1].robots for t in r.tasks}
+        observer.wait_for(lambda o: parts <= {(e.robot, e.job) for e in o.events
+                                              if e.kind == TaskEvent.KIND_OPERATION_DONE},
+                          10, "every robot's events")
         yield launcher, observer
     finally:
         launcher.stop()

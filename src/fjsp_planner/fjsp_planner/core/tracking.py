@@ -69,6 +69,8 @@ class Outcome:
     ignored: Ignored | None = None
     reason: str = ''
     job_done: tuple[str, float] | None = None
+    repeated: bool = False
+    """Ignored for a reason already counted and logged (an unknown robot's heartbeats)."""
 
 
 class MissionTracker:
@@ -80,6 +82,7 @@ class MissionTracker:
         self.robots = {r.name: RobotRecord(r.name) for r in problem.robots}
         self.ignored = Counter()
         self._event_ids: set[str] = set()
+        self._unknown_robots: set[str] = set()
 
     # --- plans -------------------------------------------------------------------------
 
@@ -145,8 +148,12 @@ class MissionTracker:
     def record_robot_state(self, robot: str, mode: str, location: str, destination: str,
                            busy_until: float) -> Outcome:
         if robot not in self.robots:
-            self.ignored[Ignored.UNKNOWN] += 1
-            return Outcome(Ignored.UNKNOWN, f"state of unknown robot '{robot}'")
+            repeated = robot in self._unknown_robots
+            if not repeated:
+                self._unknown_robots.add(robot)
+                self.ignored[Ignored.UNKNOWN] += 1
+            return Outcome(Ignored.UNKNOWN, f"state of unknown robot '{robot}'",
+                           repeated=repeated)
         self.robots[robot] = RobotRecord(robot, mode, location, destination, busy_until, True)
         return Outcome()
 

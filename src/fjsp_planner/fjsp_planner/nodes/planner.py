@@ -195,7 +195,7 @@ class PlannerNode(Node):
         mode = MODE_NAMES[msg.mode] if msg.mode < len(MODE_NAMES) else f'mode {msg.mode}'
         outcome = self.tracker.record_robot_state(msg.robot, mode, msg.location,
                                                   msg.destination, msg.busy_until)
-        if outcome.ignored:
+        if outcome.ignored and not outcome.repeated:
             self.ignored(outcome, 'robot state')
 
     def on_event(self, msg: TaskEvent) -> None:
