@@ -106,9 +106,6 @@ def test_nodes_exit_cleanly_on_interrupt(mission):
     launcher, observer = mission
     assert observer.status.state == MissionStatus.STATE_COMPLETE
     codes = launcher.stop()
-    # After a solve, CP-SAT's catch_sigint_signal has left SIGINT at its default action, so
-    # the planner dies of the signal (-2) instead of shutting down; it must not hang.
-    assert codes.pop('planner') in (0, -2)
     assert codes == {name: 0 for name in codes}, codes
     for name in codes:
         assert 'Traceback' not in launcher.log(name), name

@@ -75,6 +75,9 @@ def _run(model, time_limit, workers, log):
     solver.parameters.max_time_in_seconds = max(0.01, time_limit)
     solver.parameters.num_workers = workers
     solver.parameters.log_search_progress = log
+    # CP-SAT otherwise replaces the process's SIGINT handler, so a node that solved once
+    # dies of Ctrl-C instead of shutting down cleanly.
+    solver.parameters.catch_sigint_signal = False
     # Presolve probing took the whole budget at 5 panels before any search (and slowed the
     # 1-panel proof 2x), while it did not tighten the bound measurably at 2 panels.
     solver.parameters.cp_model_probing_level = 0
