@@ -2,8 +2,12 @@
 
 Times are schedule units since the mission start. The tracker turns task events into the
 facts re-planning needs (`execution_state`: done and running jobs, where each robot is and
-when it is free), the executed timeline (`executed_schedule`, checkable by `validate`) and a
-projected makespan. Every report it cannot use is classified and counted, never raised.
+when it is free), the executed timeline (`executed_schedule`, checkable by `validate`), a
+projected makespan and the operations running late (`overruns`). Every report it cannot use
+is classified and counted, never raised.
+
+A plan revision either continues a job (it was under way) or starts it afresh: reports about
+a job made under a revision older than the one that last started it no longer count.
 """
 
 import math
@@ -34,18 +38,25 @@ class Ignored(StrEnum):
 
 # Robot modes as agents report them; the tracker only needs to tell these apart.
 TRAVELLING = 'travelling'
-UNHEALTHY_MODES = frozenset({'failed', 'offline'})
+WORKING = 'working'
+OFFLINE = 'offline'
+UNHEALTHY_MODES = frozenset({'failed', OFFLINE})
 
 
 @dataclass
 class JobRecord:
-    """What has been reported about one job under the current plan."""
+    """What has been reported about one job since the revision that last started it."""
 
     name: str
+    since_revision: int = 0
     arrived: dict[str, float] = field(default_factory=dict)
     started: dict[str, float] = field(default_factory=dict)
     operation_done: dict[str, float] = field(default_factory=dict)
     end: float | None = None
+    aborted: bool = False
+    """A robot on it failed while working: it waits for a new revision to be redone."""
+    done_as: JobAssignment | None = None
+    """The plan and robots it was completed with."""
 
     @property
     def start(self) -> float | None:
@@ -59,7 +70,14 @@ class RobotRecord:
     location: str = ''
     destination: str = ''
     busy_until: float = math.nan
+    current_job: str = ''
     reported: bool = False
+
+    @property
+    def healthy(self) -> bool:
+        """Failed or offline robots are not; one that has not reported yet is taken to be
+        (it gets its tasks when it joins)."""
+        return self.mode not in UNHEALTHY_MODES
 
 
 @dataclass(frozen=True)
@@ -86,10 +104,21 @@ class MissionTracker:
 
     # --- plans -------------------------------------------------------------------------
 
-    def set_plan(self, schedule: Schedule, revision: int) -> None:
-        """Follow a new plan revision; what was reported about finished jobs stays."""
+    def set_plan(self, schedule: Schedule, revision: int, continued=frozenset()) -> None:
+        """Follow a new plan revision.
+
+        Its jobs not `continued` start afresh: what was reported about them is forgotten,
+        and reports made under an older revision are ignored from now on. What was reported
+        about jobs the revision leaves out (done before it) stays.
+        """
         if revision <= self.revision:
             raise ValueError(f'plan revision {revision} is not newer than {self.revision}')
+        unknown = sorted(set(continued) - set(schedule.jobs))
+        if unknown:
+            raise ValueError('continued job(s) not in the plan: ' + ', '.join(unknown))
+        for name in schedule.jobs:
+            if name not in continued:
+                self.jobs[name] = JobRecord(name, since_revision=revision)
         self.plan, self.revision = schedule, revision
 
     # --- reports -----------------------------------------------------------------------
@@ -106,7 +135,9 @@ class MissionTracker:
         facts = {EventKind.ARRIVED: record.arrived, EventKind.STARTED: record.started,
                  EventKind.OPERATION_DONE: record.operation_done}
         if kind == EventKind.ABORTED:
-            self.jobs[job] = JobRecord(job)
+            if record.end is not None:
+                return Outcome()
+            self.jobs[job] = JobRecord(job, since_revision=record.since_revision, aborted=True)
             return Outcome()
         if robot in facts[kind] or record.end is not None:
             self.ignored[Ignored.DUPLICATE] += 1
@@ -117,6 +148,9 @@ class MissionTracker:
             robots = self.plan.jobs[job].robots
             if all(r in record.operation_done for r in robots):
                 record.end = max(record.operation_done[r] for r in robots)
+                planned = self.plan.jobs[job]
+                record.done_as = JobAssignment(job, planned.plan, Fraction(record.start),
+                                               Fraction(record.end), dict(robots))
                 return Outcome(job_done=(job, record.end))
         return Outcome()
 
@@ -134,6 +168,17 @@ class MissionTracker:
             return Outcome(Ignored.UNKNOWN, f"event '{event_id}' follows plan revision "
                                             f'{revision}, which was never published '
                                             f'(current: {self.revision})')
+        if revision < self.jobs[job].since_revision:
+            return Outcome(Ignored.STALE, f"event '{event_id}' follows plan revision "
+                                          f"{revision}; revision "
+                                          f'{self.jobs[job].since_revision} started '
+                                          f"'{job}' afresh")
+        if self.jobs[job].aborted:
+            return Outcome(Ignored.STALE, f"event '{event_id}': job '{job}' was aborted and "
+                                          'waits for a new revision to be redone')
+        if job not in self.plan.jobs:
+            return Outcome(Ignored.STALE, f"event '{event_id}': job '{job}' is not in plan "
+                                          f'revision {self.revision}, it was done before')
         if robot not in self.plan.jobs[job].robots:
             if revision < self.revision:
                 return Outcome(Ignored.STALE, f"event '{event_id}' follows plan revision "
@@ -146,7 +191,7 @@ class MissionTracker:
         return None
 
     def record_robot_state(self, robot: str, mode: str, location: str, destination: str,
-                           busy_until: float) -> Outcome:
+                           busy_until: float, current_job: str = '') -> Outcome:
         if robot not in self.robots:
             repeated = robot in self._unknown_robots
             if not repeated:
@@ -154,8 +199,13 @@ class MissionTracker:
                 self.ignored[Ignored.UNKNOWN] += 1
             return Outcome(Ignored.UNKNOWN, f"state of unknown robot '{robot}'",
                            repeated=repeated)
-        self.robots[robot] = RobotRecord(robot, mode, location, destination, busy_until, True)
+        self.robots[robot] = RobotRecord(robot, mode, location, destination, busy_until,
+                                         current_job, True)
         return Outcome()
+
+    def mark_offline(self, robot: str) -> None:
+        """Its heartbeat was lost: treated as failed until it reports again."""
+        self.robots[robot].mode = OFFLINE
 
     # --- what the reports add up to ------------------------------------------------------
 
@@ -171,6 +221,14 @@ class MissionTracker:
     def running(self) -> frozenset[str]:
         return frozenset(name for name, r in self.jobs.items()
                          if r.end is None and r.started)
+
+    @property
+    def aborted(self) -> frozenset[str]:
+        return frozenset(name for name, r in self.jobs.items() if r.aborted)
+
+    @property
+    def healthy(self) -> frozenset[str]:
+        return frozenset(name for name, r in self.robots.items() if r.healthy)
 
     @property
     def complete(self) -> bool:
@@ -195,7 +253,8 @@ class MissionTracker:
             if record.end is not None:
                 end = Fraction(record.end)
             elif record.start is not None:
-                end = max(Fraction(record.start) + self._planned_length(name), now)
+                end = max(Fraction(record.start) + self._planned_length(name), now,
+                          self._reported_end(name))
             else:
                 start = now
                 for before in self.problem.predecessors(name):
@@ -212,16 +271,40 @@ class MissionTracker:
                 robot_free[robot] = (end, self.problem.job(name).location)
         return ends
 
+    def _reported_end(self, job: str) -> Fraction:
+        """The latest end its working robots expect for their operations (0: none said)."""
+        ends = [Fraction(r.busy_until) for r in self.robots.values()
+                if r.current_job == job and r.mode == WORKING and math.isfinite(r.busy_until)
+                and r.name not in self.jobs[job].operation_done]
+        return max(ends, default=Fraction(0))
+
     def projected_makespan(self, now: float) -> Fraction:
-        return max(self.expected_ends(now).values(), default=Fraction(0))
+        ends = list(self.expected_ends(now).values())
+        ends += [Fraction(r.end) for r in self.jobs.values() if r.end is not None]
+        return max(ends, default=Fraction(0))
+
+    def overruns(self, threshold: float) -> list[str]:
+        """Running jobs whose robots expect to end more than `threshold` after the plan said.
+
+        Only the robots' reported expected ends count: a clock running ahead of delayed
+        messages is no overrun. The plan's end is taken from the job's actual start, so a job
+        that merely started late is not overrunning; a re-plan makes the expected end the
+        planned one.
+        """
+        late = []
+        for name in sorted(self.running):
+            record = self.jobs[name]
+            planned = max(self.plan.jobs[name].end,
+                          Fraction(record.start) + self._planned_length(name))
+            expected = self._reported_end(name)
+            if expected - planned > threshold:
+                late.append(f"job '{name}' is expected to end at {float(expected):.2f}, "
+                            f'{float(expected - planned):.2f} after its plan')
+        return late
 
     def executed_schedule(self) -> Schedule:
         """The jobs completed so far, as executed: for `validate` and Gantt charts."""
-        jobs = {}
-        for name in self.done:
-            record, planned = self.jobs[name], self.plan.jobs[name]
-            jobs[name] = JobAssignment(name, planned.plan, Fraction(record.start),
-                                       Fraction(record.end), dict(planned.robots))
+        jobs = {name: self.jobs[name].done_as for name in self.done}
         sequences = {r.name: tuple(sorted((j for j, a in jobs.items() if r.name in a.robots),
                                           key=lambda j: jobs[j].start))
                      for r in self.problem.robots}
@@ -246,6 +329,5 @@ class MissionTracker:
                 location, free_at = r.destination, max(Fraction(arrival), now_f)
             else:
                 location, free_at = r.location or None, now_f
-            robots[name] = RobotState(name, r.reported and r.mode not in UNHEALTHY_MODES,
-                                      location, free_at)
+            robots[name] = RobotState(name, r.healthy, location, free_at)
         return ExecutionState(now_f, self.done, running, robots)

@@ -21,32 +21,38 @@ def _float(value) -> float:
     return math.nan if value is None else float(value)
 
 
-def plan_msg(problem: Problem, schedule: Schedule, result: Result, revision: int,
-             mission_start, time_scale: float, stamp) -> Plan:
-    """The plan message of a schedule: every robot's tasks with travel, times and partners."""
-    holds = {(a, q): b for a, b, q in problem.holding}
+def plan_msg(scenario: Problem, posed: Problem, schedule: Schedule, result: Result,
+             revision: int, mission_start, time_scale: float, stamp,
+             continued=frozenset()) -> Plan:
+    """The plan message of a schedule of `posed`: every robot's tasks with travel, times and
+    partners. `posed` is the scenario itself, or what remained of it at a re-plan; every
+    robot of the scenario is listed, the ones left out of `posed` with no task."""
+    holds = {(a, q): b for a, b, q in posed.holding}
+    in_posed = {r.name for r in posed.robots}
     robots = []
-    for robot in problem.robots:
-        sequence = schedule.sequences.get(robot.name, ())
+    for robot in scenario.robots:
+        sequence = schedule.sequences.get(robot.name, ()) if robot.name in in_posed else ()
         tasks = []
-        for index, visit in enumerate(schedule.visits(problem, robot.name)):
+        visits = schedule.visits(posed, robot.name) if sequence else ()
+        for index, visit in enumerate(visits):
             a = schedule.jobs[visit.job]
             q = a.robots[robot.name]
             following = sequence[index + 1] if index + 1 < len(sequence) else None
             tasks.append(PlanTask(
                 job=visit.job, process_plan=a.plan, operation_type=q,
-                operation_name=problem.operation_types[q],
-                location=problem.job(visit.job).location,
+                operation_name=posed.operation_types[q],
+                location=posed.job(visit.job).location,
                 travel_start=float(visit.travel_start), arrival=float(visit.arrival),
                 start=float(a.start),
-                operation_end=float(a.start + problem.duration(robot.name, q)),
+                operation_end=float(a.start + posed.duration(robot.name, q)),
                 end=float(a.end),
                 co_workers=sorted(r for r in a.robots if r != robot.name),
-                predecessors=problem.predecessors(visit.job),
+                predecessors=posed.predecessors(visit.job),
                 held_into_next=following is not None
-                and holds.get((visit.job, q)) == following))
+                and holds.get((visit.job, q)) == following,
+                continued=visit.job in continued))
         robots.append(RobotPlan(robot=robot.name, robot_type=robot.type, tasks=tasks))
-    return Plan(stamp=stamp, revision=revision, scenario_id=problem.name,
+    return Plan(stamp=stamp, revision=revision, scenario_id=scenario.name,
                 mission_start=mission_start, time_scale=time_scale,
                 makespan=float(result.makespan), solver_status=str(result.status),
                 lower_bound=_float(result.lower_bound), robots=robots)
@@ -55,9 +61,13 @@ def plan_msg(problem: Problem, schedule: Schedule, result: Result, revision: int
 def job_states(tracker: MissionTracker) -> list[JobState]:
     states = []
     for name, record in tracker.jobs.items():
-        planned = tracker.plan.jobs.get(name) if tracker.plan is not None else None
+        planned = record.done_as
+        if planned is None and tracker.plan is not None:
+            planned = tracker.plan.jobs.get(name)
         if record.end is not None:
             state = JobState.STATE_DONE
+        elif record.aborted:
+            state = JobState.STATE_ABORTED
         elif record.started:
             state = JobState.STATE_RUNNING
         else:

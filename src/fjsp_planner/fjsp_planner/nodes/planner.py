@@ -1,8 +1,10 @@
-"""The planner node: waits for the fleet, solves the scenario, publishes the plan latched and
-tracks its execution from the robots' task events (see docs/ros-interfaces.md)."""
+"""The planner node: waits for the fleet, solves the scenario, publishes the plan latched,
+tracks its execution from the robots' reports, and re-plans what remains when a robot fails,
+goes silent, recovers or runs late (see docs/ros-interfaces.md)."""
 
 import math
 import sys
+import time
 from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
 
@@ -16,10 +18,11 @@ from rclpy.time import Time
 
 from fjsp_msgs.msg import JobStates, MissionStatus, Plan, RobotState, TaskEvent
 from fjsp_planner.core.problem import Problem, ProblemError
+from fjsp_planner.core.replan import Replan, replan
 from fjsp_planner.core.scenario import load_scenario
-from fjsp_planner.core.schedule import Result
+from fjsp_planner.core.schedule import Result, Schedule
 from fjsp_planner.core.solve import solve
-from fjsp_planner.core.tracking import Ignored, MissionTracker
+from fjsp_planner.core.tracking import OFFLINE, Ignored, MissionTracker
 from fjsp_planner.core.validate import validate
 from fjsp_planner.nodes.conversions import EVENT_KINDS, MODE_NAMES, job_states, plan_msg
 from fjsp_planner.nodes.interfaces import (
@@ -54,12 +57,18 @@ class PlannerNode(Node):
         shift = self.parameter('shift', -1.0)
         self.solver = self.parameter('solver', 'cpsat')
         self.time_limit = self.parameter('time_limit', 10.0)
+        self.replan_time_limit = self.parameter('replan_time_limit', 1.0)
         self.workers = self.parameter('workers', 2)
+        self.heartbeat_timeout = self.parameter('heartbeat_timeout', 1.0)
+        self.delay_threshold = self.parameter('delay_threshold', 2.0)
         self.time_scale = self.parameter('time_scale', 0.05)
         self.robot_wait_timeout = self.parameter('robot_wait_timeout', 15.0)
         self.start_delay = self.parameter('start_delay', 0.5)
         status_period = self.parameter('status_period', 0.5)
         for name, value, low in (('panels', panels, 0), ('time_limit', self.time_limit, 1e-9),
+                                 ('replan_time_limit', self.replan_time_limit, 1e-9),
+                                 ('heartbeat_timeout', self.heartbeat_timeout, 1e-9),
+                                 ('delay_threshold', self.delay_threshold, 0),
                                  ('workers', self.workers, 1),
                                  ('time_scale', self.time_scale, 1e-9),
                                  ('robot_wait_timeout', self.robot_wait_timeout, 0),
@@ -82,9 +91,15 @@ class PlannerNode(Node):
         self.state = MissionStatus.STATE_WAITING_FOR_ROBOTS
         self.blocked: list[str] = []
         self.plan: Plan | None = None
+        self.schedule: Schedule | None = None
         self.mission_start: Time | None = None
         self.job_done_ids: set[str] = set()
         self.solving: Future | None = None
+        self.planned_health: frozenset[str] = frozenset()
+        """The robots the current plan (or the blocked verdict) took as healthy."""
+        self.solving_health: frozenset[str] = frozenset()
+        self.last_heard: dict[str, float] = {}
+        self.last_tick = time.monotonic()
         # One worker thread: the solve runs there so the executor keeps serving callbacks.
         self.pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix='solver')
         self.waiting_since = self.get_clock().now()
@@ -120,6 +135,7 @@ class PlannerNode(Node):
     # --- planning --------------------------------------------------------------------
 
     def tick(self) -> None:
+        self.check_heartbeats()
         if self.state == MissionStatus.STATE_WAITING_FOR_ROBOTS:
             missing = self.tracker.missing_robots
             waited = (self.get_clock().now() - self.waiting_since).nanoseconds * 1e-9
@@ -133,20 +149,29 @@ class PlannerNode(Node):
                     f'planning without a report from {", ".join(missing)} after waiting '
                     f'{self.robot_wait_timeout:g} s; they get the plan when they join')
             self.start_solve()
-        elif self.solving is not None and self.solving.done():
-            future, self.solving = self.solving, None
-            self.finish_solve(future)
+        elif self.solving is not None:
+            if self.solving.done():
+                future, self.solving = self.solving, None
+                if self.state == MissionStatus.STATE_PLANNING:
+                    self.finish_solve(future)
+                else:
+                    self.finish_replan(future)
+        elif self.state in (MissionStatus.STATE_EXECUTING, MissionStatus.STATE_BLOCKED):
+            reasons = self.replan_reasons()
+            if reasons:
+                self.start_replan(reasons)
 
     def start_solve(self) -> None:
         self.state = MissionStatus.STATE_PLANNING
         self.get_logger().info(f'solving with {self.solver}, time limit {self.time_limit:g} s, '
                                f'{self.workers} workers')
+        # Plans for every robot; one already known to be out is re-planned away at once.
+        self.solving_health = frozenset(r.name for r in self.problem.robots)
         self.solving = self.pool.submit(solve, self.problem, solver=self.solver,
                                         time_limit=self.time_limit, workers=self.workers)
         self.publish_status()
 
     def finish_solve(self, future: Future) -> None:
-        log = self.get_logger()
         try:
             result: Result = future.result()
         except ValueError as error:
@@ -160,23 +185,126 @@ class PlannerNode(Node):
         if problems:
             self.fail([f'solver returned an invalid schedule: {p}' for p in problems])
             return
+        self.planned_health = self.solving_health
+        self.publish_plan(self.problem, result)
+
+    # --- re-planning -----------------------------------------------------------------
+
+    def replan_reasons(self) -> list[str]:
+        """Why the current plan (or blocked verdict) no longer fits the fleet; empty if it
+        does. Late operations count only while executing: a blocked mission waits for a
+        robot to come back."""
+        tracker = self.tracker
+        healthy = tracker.healthy
+        reasons = [f"robot '{r}' {tracker.robots[r].mode}"
+                   for r in sorted(self.planned_health - healthy)]
+        reasons += [f"robot '{r}' back in service" for r in sorted(healthy - self.planned_health)]
+        if self.state == MissionStatus.STATE_EXECUTING:
+            reasons += [f"job '{j}' aborted" for j in sorted(tracker.aborted)]
+            reasons += tracker.overruns(self.delay_threshold)
+        return reasons
+
+    def start_replan(self, reasons: list[str]) -> None:
+        self.state = MissionStatus.STATE_REPLANNING
+        now = self.now_units()
+        self.get_logger().warning(f're-planning at t={now:.2f}: ' + '; '.join(reasons))
+        try:
+            state = self.tracker.execution_state(now)
+        except ValueError as error:
+            self.block([f'cannot tell the execution state: {error}'])
+            return
+        self.solving_health = self.tracker.healthy
+        self.solving = self.pool.submit(replan, self.problem, self.schedule, state,
+                                        time_limit=self.replan_time_limit,
+                                        workers=self.workers)
+        self.publish_status()
+
+    def finish_replan(self, future: Future) -> None:
+        log = self.get_logger()
+        if self.tracker.complete:
+            self.state = MissionStatus.STATE_COMPLETE
+            return
+        if self.tracker.healthy != self.solving_health:
+            # The fleet changed while solving: this plan would give work to a robot that is
+            # out, or leave out one that is back. The next tick re-plans from the new state.
+            log.warning('discarding the re-plan: the fleet changed while it was solved')
+            self.state = MissionStatus.STATE_EXECUTING
+            return
+        self.planned_health = self.solving_health
+        try:
+            outcome: Replan = future.result()
+        except ValueError as error:
+            self.block([f're-planning failed: {error}'])
+            return
+        residual = outcome.residual
+        if residual.complete:
+            self.state = MissionStatus.STATE_EXECUTING
+            return
+        if residual.blocked:
+            self.block(residual.blocked)
+            return
+        result = outcome.result
+        if result.schedule is None:
+            self.block([f"no plan for what remains: solver '{result.solver}' answered "
+                        f'{result.status} within {self.replan_time_limit:g} s'])
+            return
+        if outcome.problems:
+            self.block([f're-planned schedule is invalid: {p}' for p in outcome.problems])
+            return
+        for what, jobs in (('redone', residual.aborted), ('voided', residual.voided),
+                           ('kept held', residual.kept)):
+            if jobs:
+                log.info(f'  {what}: {", ".join(jobs)}')
+        self.blocked = []
+        self.publish_plan(residual.problem, result, frozenset(residual.problem.fixed))
+
+    def publish_plan(self, posed: Problem, result: Result, continued=frozenset()) -> None:
+        """Publish `result` (a schedule of `posed`) as the next revision and follow it."""
+        log = self.get_logger()
         revision = self.tracker.revision + 1
-        self.tracker.set_plan(result.schedule, revision)
+        self.tracker.set_plan(result.schedule, revision, continued)
+        self.schedule = result.schedule
         now = self.get_clock().now()
-        self.mission_start = now + Duration(nanoseconds=int(self.start_delay * 1e9))
-        self.plan = plan_msg(self.problem, result.schedule, result, revision,
-                             self.mission_start.to_msg(), self.time_scale, now.to_msg())
+        if self.mission_start is None:
+            self.mission_start = now + Duration(nanoseconds=int(self.start_delay * 1e9))
+        self.plan = plan_msg(self.problem, posed, result.schedule, result, revision,
+                             self.mission_start.to_msg(), self.time_scale, now.to_msg(),
+                             continued)
         self.plan_pub.publish(self.plan)
         self.state = MissionStatus.STATE_EXECUTING
         gap = f', gap {result.gap:.1%}' if result.gap is not None else ''
         log.info(f'published plan revision {revision}: makespan {float(result.makespan):g} '
-                 f'({result.status}{gap}, {result.solve_seconds:.2f} s); mission starts in '
-                 f'{self.start_delay:g} s at {self.time_scale:g} s per unit')
+                 f'({result.status}{gap}, {result.solve_seconds:.2f} s)'
+                 + (f'; mission starts in {self.start_delay:g} s at {self.time_scale:g} s '
+                    'per unit' if revision == 1 else f' at t={self.now_units():.2f}'))
         for robot_plan in self.plan.robots:
             log.info(f'  {robot_plan.robot}: '
                      + (' -> '.join(t.job for t in robot_plan.tasks) or 'no task'))
         self.publish_jobs()
         self.publish_status()
+
+    def block(self, reasons: list[str]) -> None:
+        """Nothing can be planned until the fleet changes; the current plan stays, so the
+        robots finish what they can of it."""
+        self.state = MissionStatus.STATE_BLOCKED
+        self.blocked = reasons
+        for reason in reasons:
+            self.get_logger().error(f'blocked: {reason}')
+        self.publish_status()
+
+    def check_heartbeats(self) -> None:
+        now = time.monotonic()
+        starved, self.last_tick = now - self.last_tick > 0.25, now
+        if starved:
+            # The executor could not take messages for a while: the heartbeats it has not
+            # processed yet come first, before any robot is judged silent.
+            return
+        for robot, heard in self.last_heard.items():
+            record = self.tracker.robots[robot]
+            if record.mode != OFFLINE and now - heard > self.heartbeat_timeout:
+                self.tracker.mark_offline(robot)
+                self.get_logger().error(f"robot '{robot}' offline: no state for "
+                                        f'{now - heard:.1f} s; treated as failed')
 
     def fail(self, reasons: list[str]) -> None:
         self.state = MissionStatus.STATE_FAILED
@@ -193,10 +321,18 @@ class PlannerNode(Node):
 
     def on_robot_state(self, msg: RobotState) -> None:
         mode = MODE_NAMES[msg.mode] if msg.mode < len(MODE_NAMES) else f'mode {msg.mode}'
+        was_offline = msg.robot in self.tracker.robots \
+            and self.tracker.robots[msg.robot].mode == OFFLINE
         outcome = self.tracker.record_robot_state(msg.robot, mode, msg.location,
-                                                  msg.destination, msg.busy_until)
-        if outcome.ignored and not outcome.repeated:
-            self.ignored(outcome, 'robot state')
+                                                  msg.destination, msg.busy_until,
+                                                  msg.current_job)
+        if outcome.ignored:
+            if not outcome.repeated:
+                self.ignored(outcome, 'robot state')
+            return
+        self.last_heard[msg.robot] = time.monotonic()
+        if was_offline:
+            self.get_logger().warning(f"robot '{msg.robot}' reports again ({mode})")
 
     def on_event(self, msg: TaskEvent) -> None:
         if msg.kind == TaskEvent.KIND_JOB_DONE:
