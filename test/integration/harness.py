@@ -12,6 +12,8 @@ import signal
 import subprocess
 import threading
 import time
+from collections import defaultdict
+from fractions import Fraction
 from pathlib import Path
 
 import pytest
@@ -26,6 +28,7 @@ import rclpy  # noqa: E402  (after the environment check, for a clear message)
 from rclpy.executors import SingleThreadedExecutor  # noqa: E402
 
 from fjsp_msgs.msg import JobStates, MissionStatus, Plan, RobotState, TaskEvent  # noqa: E402
+from fjsp_planner.core.schedule import JobAssignment, Schedule  # noqa: E402
 from fjsp_planner.nodes.interfaces import (  # noqa: E402
     EVENTS_QOS,
     JOB_STATES_TOPIC,
@@ -84,6 +87,16 @@ class Launcher:
     def log(self, name) -> str:
         return (self.logs / f'{name}.log').read_text()
 
+    def kill(self, name) -> None:
+        """SIGKILL, as a crash would: the process gets no chance to say goodbye."""
+        os.killpg(self.processes[name].pid, signal.SIGKILL)
+        self.processes[name].wait(timeout=5)
+
+    def inject_fault(self, robot, *args, timeout=10):
+        """`ros2 run fjsp_planner inject_fault ROBOT ...`, as a user's test script would."""
+        return subprocess.run(['ros2', 'run', 'fjsp_planner', 'inject_fault', robot, *args],
+                              env=self.env, capture_output=True, text=True, timeout=timeout)
+
     def stop(self, name=None, timeout=5.0) -> dict[str, int]:
         """SIGINT the process groups, SIGKILL what outlives `timeout`; the exit codes."""
         names = [name] if name else list(self.processes)
@@ -115,6 +128,7 @@ class Observer:
         self.events: list[TaskEvent] = []
         self.status: MissionStatus | None = None
         self.robots: dict[str, RobotState] = {}
+        self.robot_history: list[RobotState] = []
         self.job_states: JobStates | None = None
         node = self.node
         node.create_subscription(Plan, PLAN_TOPIC, self._add('plans'), LATCHED_QOS)
@@ -155,6 +169,7 @@ class Observer:
     def _robot(self, msg):
         with self.lock:
             self.robots[msg.robot] = msg
+            self.robot_history.append(msg)
             self.lock.notify_all()
 
     def wait_for(self, predicate, timeout, what):
@@ -175,3 +190,45 @@ class Observer:
         self.node.destroy_node()
         rclpy.try_shutdown(context=self.context)
         self.thread.join(timeout=2.0)
+
+
+def restart_revisions(plans) -> dict[str, int]:
+    """Per job, the last plan revision that (re)started it: its reports under older ones are
+    void (PlanTask.continued)."""
+    since = {}
+    for plan in plans:
+        for robot in plan.robots:
+            for task in robot.tasks:
+                if not task.continued:
+                    since[task.job] = max(since.get(task.job, 0), plan.revision)
+    return since
+
+
+def valid_events(plans, events) -> list[TaskEvent]:
+    """The events of each job's last attempt, the one that counts."""
+    since = restart_revisions(plans)
+    return [e for e in events if e.plan_revision >= since.get(e.job, 0)]
+
+
+def executed_timeline(problem, plans, events) -> Schedule:
+    """The schedule the robots actually ran, rebuilt from their task events alone (the last
+    attempt of each job), with each robot's operation as the plans that ran it gave it."""
+    started, operation_done = defaultdict(dict), defaultdict(dict)
+    for e in valid_events(plans, events):
+        if e.kind == TaskEvent.KIND_STARTED:
+            started[e.job][e.robot] = e.time
+        elif e.kind == TaskEvent.KIND_OPERATION_DONE:
+            operation_done[e.job][e.robot] = e.time
+    tasks = {(r.robot, t.job): t for plan in plans for r in plan.robots for t in r.tasks}
+    jobs = {}
+    for job, robots in started.items():
+        if set(operation_done[job]) != set(robots):
+            continue
+        ops = {robot: tasks[robot, job].operation_type for robot in robots}
+        plan = tasks[next(iter(robots)), job].process_plan
+        end = max(operation_done[job].values())
+        jobs[job] = JobAssignment(job, plan, Fraction(min(robots.values())), Fraction(end), ops)
+    sequences = {r.name: tuple(sorted((j for j, a in jobs.items() if r.name in a.robots),
+                                      key=lambda j: jobs[j].start))
+                 for r in problem.robots}
+    return Schedule(jobs, sequences)

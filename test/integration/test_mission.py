@@ -1,40 +1,15 @@
 """A whole mission over real processes: planner + the paper's four robots, via `ros2 run`."""
 
-from collections import defaultdict
-from fractions import Fraction
-
 import pytest
-from harness import ROBOTS, SCENARIO, Launcher, Observer, new_domain
+from harness import ROBOTS, SCENARIO, Launcher, Observer, executed_timeline, new_domain
 
 from fjsp_msgs.msg import MissionStatus, TaskEvent
 from fjsp_planner.core.scenario import load_scenario
-from fjsp_planner.core.schedule import JobAssignment, Schedule
 from fjsp_planner.core.validate import validate
 
 MAKESPAN_TOLERANCE = 0.01
 """Executed makespan may exceed the plan by 1 %: agents keep logical time, so the only slack
 is the rounding-up of reported ends (1e-6 units per leg or operation)."""
-
-
-def executed_timeline(problem, plans, events) -> Schedule:
-    """The schedule the robots actually ran, rebuilt from their task events alone."""
-    started, operation_done = defaultdict(dict), defaultdict(dict)
-    for e in events:
-        if e.kind == TaskEvent.KIND_STARTED:
-            started[e.job][e.robot] = e.time
-        elif e.kind == TaskEvent.KIND_OPERATION_DONE:
-            operation_done[e.job][e.robot] = e.time
-    tasks = {(r.robot, t.job): t for r in plans[-1].robots for t in r.tasks}
-    jobs = {}
-    for job, robots in started.items():
-        ops = {robot: tasks[robot, job].operation_type for robot in robots}
-        plan = tasks[next(iter(robots)), job].process_plan
-        end = max(operation_done[job].values())
-        jobs[job] = JobAssignment(job, plan, Fraction(min(robots.values())), Fraction(end), ops)
-    sequences = {r.name: tuple(sorted((j for j, a in jobs.items() if r.name in a.robots),
-                                      key=lambda j: jobs[j].start))
-                 for r in problem.robots}
-    return Schedule(jobs, sequences)
 
 
 @pytest.fixture(scope='module')
