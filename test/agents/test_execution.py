@@ -1,8 +1,13 @@
 """The agents' ROS-free execution logic, on hand-checkable two-robot sequences."""
 
+import math
+
 import pytest
 
 from robot_agents.execution import EventKind, Mode, RobotExecution, Task
+
+ARRIVED, STARTED, DONE, ABORTED = (EventKind.ARRIVED, EventKind.STARTED,
+                                   EventKind.OPERATION_DONE, EventKind.ABORTED)
 
 
 def task(job, start, duration, end=None, leg=0.0, co=(), preds=(), held=False, location=None):
@@ -12,72 +17,321 @@ def task(job, start, duration, end=None, leg=0.0, co=(), preds=(), held=False, l
                 predecessors=tuple(preds), held_into_next=held)
 
 
+def plan(r, revision, tasks, job_robots=None, now=0.0, continued=()):
+    """Give robot `r` a revision; by default it does every job alone."""
+    job_robots = job_robots if job_robots is not None else {t.job: {r.robot} for t in tasks}
+    r.set_plan(revision, tasks, job_robots, now, continued=continued)
+
+
 def kinds(events):
     return [(e.kind, e.job, round(e.time, 4)) for e in events]
 
 
+def attempts(events):
+    return [(e.kind, e.job, e.attempt) for e in events]
+
+
 def test_solo_sequence_travels_and_works_in_logical_time():
     r = RobotExecution('A')
-    r.set_plan(1, [task('J1', 0, 2), task('J2', 5, 1, leg=3)], {'J1': {'A'}, 'J2': {'A'}}, 0)
-    assert kinds(r.step(0)) == [(EventKind.ARRIVED, 'J1', 0), (EventKind.STARTED, 'J1', 0)]
+    plan(r, 1, [task('J1', 0, 2), task('J2', 5, 1, leg=3)])
+    assert kinds(r.step(0)) == [(ARRIVED, 'J1', 0), (STARTED, 'J1', 0)]
     assert r.mode == Mode.WORKING and r.progress(1) == pytest.approx(0.5)
     # Stepping late (at 10) still reports the instants the work was due at.
-    assert kinds(r.step(10)) == [(EventKind.OPERATION_DONE, 'J1', 2),
-                                 (EventKind.ARRIVED, 'J2', 5), (EventKind.STARTED, 'J2', 5),
-                                 (EventKind.OPERATION_DONE, 'J2', 6)]
+    assert kinds(r.step(10)) == [(DONE, 'J1', 2), (ARRIVED, 'J2', 5), (STARTED, 'J2', 5),
+                                 (DONE, 'J2', 6)]
     assert r.finished and r.mode == Mode.IDLE and r.location == 'J2'
 
 
 def test_job_waits_for_co_workers_and_predecessors():
     r = RobotExecution('A')
-    r.set_plan(1, [task('J2', 4, 1, co=['B'], preds=['J1'])], {'J1': {'B'}, 'J2': {'A', 'B'}}, 0)
-    assert kinds(r.step(3)) == [(EventKind.ARRIVED, 'J2', 0)]
+    plan(r, 1, [task('J2', 4, 1, co=['B'], preds=['J1'])], {'J1': {'B'}, 'J2': {'A', 'B'}})
+    assert kinds(r.step(3)) == [(ARRIVED, 'J2', 0)]
     assert r.mode == Mode.WAITING
-    r.operation_done('B', 'J1', 3.0)      # J1's only robot is done: J1 is complete at 3
+    r.operation_done('B', 'J1', 3.0, 1)   # J1's only robot is done: J1 is complete at 3
     assert r.step(3.5) == []              # B has not arrived yet
-    r.arrived('B', 'J2', 3.25)
-    assert kinds(r.step(3.5)) == [(EventKind.STARTED, 'J2', 3.25)]
+    r.arrived('B', 'J2', 3.25, 1)
+    assert kinds(r.step(3.5)) == [(STARTED, 'J2', 3.25)]
     assert r.step(4.2) == []
-    assert kinds(r.step(4.3)) == [(EventKind.OPERATION_DONE, 'J2', 4.25)]
+    assert kinds(r.step(4.3)) == [(DONE, 'J2', 4.25)]
     assert r.mode == Mode.WAITING         # occupied until B's operation ends too
-    r.job_done('J2', 6.0)
+    r.job_done('J2', 6.0, 1)
     r.step(6.0)
     assert r.finished
 
 
-def test_holder_stays_holding_into_the_next_job():
+def holder():
+    """A holds jig job Ja (with B) into Aa: Ja's operations end at 1 (A) and 5 (B)."""
     r = RobotExecution('A')
-    r.set_plan(1, [task('Ja', 0, 1, end=5, co=['B'], held=True),
-                   task('Aa', 5, 5, co=['B'], preds=['Ja'], leg=2)],
-               {'Ja': {'A', 'B'}, 'Aa': {'A', 'B'}}, 0)
-    r.arrived('B', 'Ja', 0.0)
+    plan(r, 1, [task('Ja', 0, 1, end=5, co=['B'], held=True),
+                task('Aa', 5, 5, co=['B'], preds=['Ja'], leg=2)],
+         {'Ja': {'A', 'B'}, 'Aa': {'A', 'B'}})
+    r.arrived('B', 'Ja', 0.0, 1)
+    return r
+
+
+def test_holder_stays_holding_into_the_next_job():
+    r = holder()
     r.step(2)
     assert r.mode == Mode.HOLDING and r.current_job == 'Ja'
-    r.operation_done('B', 'Ja', 5.0)
-    assert kinds(r.step(5)) == [(EventKind.ARRIVED, 'Aa', 5)]   # no travel while holding
+    r.operation_done('B', 'Ja', 5.0, 1)
+    assert kinds(r.step(5)) == [(ARRIVED, 'Aa', 5)]   # no travel while holding
     assert r.mode == Mode.HOLDING and r.current_job == 'Aa'
 
 
 def test_stale_revision_is_refused():
     r = RobotExecution('A')
-    r.set_plan(2, [task('J1', 0, 1)], {'J1': {'A'}}, 0)
+    plan(r, 2, [task('J1', 0, 1)])
     with pytest.raises(ValueError, match='revision 1 is not newer than revision 2'):
-        r.set_plan(1, [], {}, 0)
-
-
-def test_new_revision_keeps_the_current_job_or_aborts_it():
-    r = RobotExecution('A')
-    r.set_plan(1, [task('J1', 0, 4), task('J2', 4, 1)], {'J1': {'A'}, 'J2': {'A'}}, 0)
-    r.step(1)
-    assert r.set_plan(2, [task('J1', 0, 4), task('J3', 4, 1)],
-                      {'J1': {'A'}, 'J3': {'A'}}, 1) == []
-    assert r.mode == Mode.WORKING and r.current_job == 'J1'
-    aborted = r.set_plan(3, [task('J3', 4, 1)], {'J3': {'A'}}, 2)
-    assert kinds(aborted) == [(EventKind.ABORTED, 'J1', 2)]
-    assert kinds(r.step(2)) == [(EventKind.ARRIVED, 'J3', 2), (EventKind.STARTED, 'J3', 2)]
+        plan(r, 1, [])
 
 
 def test_late_joiner_cannot_act_before_it_got_the_plan():
     r = RobotExecution('A')
-    r.set_plan(1, [task('J1', 0, 1)], {'J1': {'A'}}, 7.0)
-    assert kinds(r.step(7.0)) == [(EventKind.ARRIVED, 'J1', 7), (EventKind.STARTED, 'J1', 7)]
+    plan(r, 1, [task('J1', 0, 1)], now=7.0)
+    assert kinds(r.step(7.0)) == [(ARRIVED, 'J1', 7), (STARTED, 'J1', 7)]
+
+
+def test_later_revision_cannot_make_an_idle_robot_depart_in_the_past():
+    r = RobotExecution('A')
+    plan(r, 1, [task('J1', 0, 5)])
+    r.step(6)
+    assert r.finished                     # idle at J1 since 5
+    plan(r, 2, [task('J2', 8, 1, leg=3)], now=10.0)
+    assert kinds(r.step(20)) == [(ARRIVED, 'J2', 13), (STARTED, 'J2', 13), (DONE, 'J2', 14)]
+
+
+# --- faults ---------------------------------------------------------------------------
+
+def test_fail_while_working_aborts_and_stops_until_recovered_and_replanned():
+    r = RobotExecution('A')
+    plan(r, 1, [task('J1', 0, 4), task('J2', 4, 1)])
+    r.step(1)
+    result = r.fail(2.5)
+    assert result.accepted and "robot 'A' failed at t=2.50" in result.message
+    assert kinds(result.events) == [(ABORTED, 'J1', 2.5)]
+    assert result.events[0].attempt == 1 and result.events[0].reason == "robot 'A' failed"
+    assert r.mode == Mode.FAILED and r.current_job == '' and math.isnan(r.busy_until)
+    assert r.step(10) == []
+    again = r.fail(3)
+    assert not again.accepted and again.message == "fail refused: robot 'A' has already failed"
+    assert not r.delay(2.0, 3).accepted
+    plan(r, 2, [task('J2', 11, 1)], now=5)     # taken, but not acted on while failed
+    assert r.revision == 2 and r.step(12) == [] and r.mode == Mode.FAILED
+
+    result = r.recover(6)
+    assert result.accepted and "recovered at t=6.00 at 'J1'" in result.message
+    assert r.step(6) == [] and r.mode == Mode.IDLE and r.location == 'J1'   # tasks dropped
+    assert r.recover(7).message == "recover refused: robot 'A' has not failed"
+    plan(r, 3, [task('J1', 7, 4), task('J2', 11, 1)], now=7)  # J1 is redone
+    assert attempts(r.step(7)) == [(ARRIVED, 'J1', 2), (STARTED, 'J1', 2)]
+    assert kinds(r.step(20)) == [(DONE, 'J1', 11), (ARRIVED, 'J2', 11), (STARTED, 'J2', 11),
+                                 (DONE, 'J2', 12)]
+
+
+def test_fail_mid_leg_freezes_it_and_recovery_ends_the_leg():
+    r = RobotExecution('A')
+    plan(r, 1, [task('J0', 0, 1), task('J1', 5, 1, leg=4)])
+    r.step(3)                              # left J0 at 1, due at J1 at 5
+    assert r.mode == Mode.TRAVELLING and r.progress(3) == pytest.approx(0.5)
+    result = r.fail(3)
+    assert result.accepted and result.events == []
+    assert "from 'J0' to 'J1' (50% done)" in result.message
+    assert (r.mode, r.location, r.destination) == (Mode.FAILED, 'J0', 'J1')
+    assert r.progress(9) == pytest.approx(0.5)
+    assert r.step(100) == []
+
+    r.recover(10)                          # 2 units of the leg are left
+    assert (r.mode, r.current_job, r.location, r.destination) == (
+        Mode.TRAVELLING, '', 'J0', 'J1')
+    assert r.busy_until == pytest.approx(12) and r.progress(11) == pytest.approx(0.75)
+    assert r.step(11.9) == []
+    assert r.step(12.1) == []              # a leg of no task reports no arrival
+    assert (r.mode, r.location, r.destination) == (Mode.IDLE, 'J1', '')
+    plan(r, 2, [task('J1', 13, 1)], now=12.5)
+    # Its first attempt at J1 began with the leg, so this arrival is its second.
+    assert attempts(r.step(12.5)) == [(ARRIVED, 'J1', 2), (STARTED, 'J1', 2)]
+    assert r.busy_until == pytest.approx(13.5)
+
+
+def test_fail_while_holding_releases_the_hold():
+    r = holder()
+    r.operation_done('B', 'Ja', 5.0, 1)
+    r.step(6)
+    assert r.mode == Mode.HOLDING and r.current_job == 'Aa'
+    result = r.fail(6)
+    assert result.accepted and result.events == [] and r.mode == Mode.FAILED
+    # The planner voids Ja (its holder failed) and gives A nothing while it is down.
+    plan(r, 2, [], {'Ja': {'B'}, 'Aa': {'B'}}, now=6.5)
+    r.recover(8)
+    assert r.mode == Mode.IDLE and r.location == 'Aa'
+    # Ja is redone under revision 3: no longer held, so A travels there.
+    plan(r, 3, [task('Ja', 11, 1, leg=3)], now=8)
+    assert kinds(r.step(11.1)) == [(ARRIVED, 'Ja', 11), (STARTED, 'Ja', 11)]
+
+
+def test_delay_of_the_operation_under_way():
+    r = RobotExecution('A')
+    plan(r, 1, [task('J1', 0, 4)])
+    r.step(1)
+    result = r.delay(2.0, 1)
+    assert result.accepted and "job 'J1' now ends at t=8.00" in result.message
+    assert r.busy_until == pytest.approx(8) and r.progress(4) == pytest.approx(0.5)
+    assert r.step(7.9) == []
+    assert kinds(r.step(8.1)) == [(DONE, 'J1', 8)]
+
+
+def test_speed_up_cannot_end_the_operation_before_it_was_ordered():
+    r = RobotExecution('A')
+    plan(r, 1, [task('J1', 0, 4)])
+    r.step(3)
+    assert r.delay(0.5, 3).accepted        # 0 + 4 * 0.5 = 2 is already past
+    assert r.busy_until == pytest.approx(3)
+
+
+def test_delay_of_the_next_operation():
+    r = RobotExecution('A')
+    plan(r, 1, [task('J0', 0, 1), task('J1', 3, 4, leg=2), task('J2', 7, 2)])
+    r.step(2)
+    assert r.mode == Mode.TRAVELLING       # left J0 at 1, due at J1 at 3
+    result = r.delay(3.0, 2)
+    assert result.accepted and 'next operation it begins takes 3 times' in result.message
+    assert r.busy_until == pytest.approx(3)   # the leg is not slowed
+    assert kinds(r.step(3.1)) == [(ARRIVED, 'J1', 3), (STARTED, 'J1', 3)]
+    assert r.busy_until == pytest.approx(15)  # 3 + 4 * 3
+    assert kinds(r.step(20)) == [(DONE, 'J1', 15), (ARRIVED, 'J2', 15), (STARTED, 'J2', 15),
+                                 (DONE, 'J2', 17)]   # only one operation slowed
+
+
+@pytest.mark.parametrize(('factor', 'why'), [
+    (0.0, 'needs a finite factor > 0, got 0'),
+    (-2.0, 'needs a finite factor > 0, got -2'),
+    (math.nan, 'needs a finite factor > 0, got nan'),
+    (math.inf, 'needs a finite factor > 0, got inf'),
+])
+def test_delay_refuses_bad_factors(factor, why):
+    r = RobotExecution('A')
+    plan(r, 1, [task('J1', 0, 4)])
+    r.step(1)
+    result = r.delay(factor, 1)
+    assert not result.accepted and result.message == f"delay refused: robot 'A' {why}"
+    assert r.busy_until == pytest.approx(4)
+
+
+def test_delay_refused_when_nothing_is_left_to_do():
+    r = RobotExecution('A')
+    assert r.delay(2.0, 0).message == "delay refused: robot 'A' has no operation left to do"
+    plan(r, 1, [task('J1', 0, 4, end=6, co=['B'])], {'J1': {'A', 'B'}})
+    r.arrived('B', 'J1', 0.0, 1)
+    result = r.delay(2.0, 5)               # catches up first: its operation ended at 4
+    assert not result.accepted and 'no operation left' in result.message
+    assert kinds(result.events) == [(ARRIVED, 'J1', 0), (STARTED, 'J1', 0), (DONE, 'J1', 4)]
+
+
+# --- revisions: continued and restarted jobs --------------------------------------------
+
+def test_restarted_job_drops_stale_facts_and_ignores_late_ones():
+    r = RobotExecution('A')
+    jobs = {'J1': {'B'}, 'J2': {'A', 'B'}}
+    plan(r, 1, [task('J2', 0, 2, co=['B'], preds=['J1'])], jobs)
+    r.step(0)
+    r.arrived('B', 'J2', 1.0, 1)
+    r.job_done('J1', 2.0, 1)
+    # Revision 2 restarts J2 (not continued); J1 is done and no longer in the plan.
+    plan(r, 2, [task('J2', 4, 2, co=['B'], preds=['J1'])], {'J2': {'A', 'B'}}, now=3)
+    assert attempts(r.step(3)) == [(ARRIVED, 'J2', 2)]
+    assert r.mode == Mode.WAITING          # B's arrival of revision 1 no longer counts
+    assert not r.arrived('B', 'J2', 1.0, 1)   # a late report of revision 1 is ignored
+    assert r.step(5) == []
+    assert r.arrived('B', 'J2', 4.0, 2)
+    assert kinds(r.step(5)) == [(STARTED, 'J2', 4)]   # J1's completion still counts
+
+
+def test_report_of_the_new_revision_before_this_robot_follows_it():
+    r = RobotExecution('A')
+    plan(r, 1, [task('J2', 0, 2, co=['B'])], {'J2': {'A', 'B'}})
+    r.step(0)
+    r.arrived('B', 'J2', 1.0, 1)
+    r.arrived('B', 'J2', 3.5, 2)           # B follows revision 2 already
+    plan(r, 2, [task('J2', 4, 2, co=['B'])], {'J2': {'A', 'B'}}, now=4)
+    assert kinds(r.step(4)) == [(ARRIVED, 'J2', 4), (STARTED, 'J2', 4)]
+
+
+def test_continued_job_goes_on_and_restarted_one_is_abandoned():
+    r = RobotExecution('A')
+    plan(r, 1, [task('J1', 0, 4), task('J2', 4, 1)])
+    r.step(1)
+    plan(r, 2, [task('J1', 0, 4), task('J3', 4, 1)], now=1, continued={'J1'})
+    assert r.mode == Mode.WORKING and r.current_job == 'J1'
+    assert r.busy_until == pytest.approx(4)
+    # Revision 3 restarts J1: A leaves it without an event, free now, and comes back to it.
+    plan(r, 3, [task('J1', 2, 4), task('J3', 6, 1)], now=2)
+    assert attempts(r.step(2)) == [(ARRIVED, 'J1', 2), (STARTED, 'J1', 2)]
+    assert kinds(r.step(10)) == [(DONE, 'J1', 6), (ARRIVED, 'J3', 6), (STARTED, 'J3', 6),
+                                 (DONE, 'J3', 7)]
+
+
+def test_job_left_out_of_the_new_plan_is_abandoned_without_an_event():
+    r = RobotExecution('A')
+    plan(r, 1, [task('J1', 0, 4)])
+    r.step(1)
+    plan(r, 2, [task('J3', 2, 1)], now=2)
+    assert kinds(r.step(2)) == [(ARRIVED, 'J3', 2), (STARTED, 'J3', 2)]
+
+
+def test_continued_job_that_is_not_first_is_not_continued():
+    r = RobotExecution('A')
+    plan(r, 1, [task('J1', 0, 4)])
+    r.step(1)
+    plan(r, 2, [task('J0', 2, 1), task('J1', 3, 4)], now=2, continued={'J1'})
+    assert kinds(r.step(2)) == [(ARRIVED, 'J0', 2), (STARTED, 'J0', 2)]
+    assert attempts(r.step(3.1)) == [(DONE, 'J0', 1), (ARRIVED, 'J1', 2), (STARTED, 'J1', 2)]
+
+
+def test_robot_finishes_its_leg_before_following_the_new_sequence():
+    r = RobotExecution('A')
+    plan(r, 1, [task('J1', 0, 1), task('J2', 5, 1, leg=4)])
+    r.step(2)                              # on its way to J2, due at 5
+    plan(r, 2, [task('J3', 8, 1, leg=3)], now=2)
+    assert (r.mode, r.current_job, r.location, r.destination) == (
+        Mode.TRAVELLING, '', 'J1', 'J2')
+    assert r.busy_until == pytest.approx(5)
+    assert kinds(r.step(10)) == [(ARRIVED, 'J3', 8), (STARTED, 'J3', 8), (DONE, 'J3', 9)]
+
+
+def test_own_operation_done_and_continued_keeps_waiting_for_the_job_end():
+    r = RobotExecution('A')
+    plan(r, 1, [task('J1', 0, 1, end=3, co=['B'])], {'J1': {'A', 'B'}})
+    r.arrived('B', 'J1', 0.0, 1)
+    r.step(2)
+    plan(r, 2, [task('J1', 0, 1, end=3, co=['B'])], {'J1': {'A', 'B'}}, now=2,
+         continued={'J1'})
+    assert r.mode == Mode.WAITING and r.current_job == 'J1'
+    r.operation_done('B', 'J1', 3.0, 1)
+    r.step(3)
+    assert r.finished
+
+
+def test_holder_keeps_holding_through_a_restart_of_the_held_job():
+    r = holder()
+    r.operation_done('B', 'Ja', 5.0, 1)
+    r.step(6)                              # holding Ja's part, waiting at Aa for B
+    # Revision 2 keeps the done jig job Ja for its holder and restarts Aa.
+    plan(r, 2, [task('Ja', 0, 1, end=5, held=True),
+                task('Aa', 8, 5, co=['C'], preds=['Ja'], leg=2)],
+         {'Ja': {'A'}, 'Aa': {'A', 'C'}}, now=7, continued={'Ja'})
+    assert attempts(r.step(7)) == [(ARRIVED, 'Aa', 2)]   # no travel: still holding
+    assert r.mode == Mode.HOLDING
+    r.arrived('C', 'Aa', 8.0, 2)
+    assert kinds(r.step(8)) == [(STARTED, 'Aa', 8)]
+
+
+def test_running_held_job_after_a_done_jig_job_is_continued():
+    r = holder()
+    r.operation_done('B', 'Ja', 5.0, 1)
+    r.arrived('B', 'Aa', 5.0, 1)
+    r.step(6)
+    assert r.mode == Mode.WORKING and r.current_job == 'Aa'
+    plan(r, 2, [task('Ja', 0, 1, end=5, held=True), task('Aa', 5, 5, co=['B'], preds=['Ja'])],
+         {'Ja': {'A'}, 'Aa': {'A', 'B'}}, now=6, continued={'Ja', 'Aa'})
+    assert r.mode == Mode.WORKING and r.current_job == 'Aa'
+    assert kinds(r.step(10.1)) == [(DONE, 'Aa', 10)]

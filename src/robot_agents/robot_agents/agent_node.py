@@ -2,25 +2,28 @@
 
 One process per robot (`robot_name` parameter); the three executables differ only in the robot
 type they accept, so a plan that gives MARC1 to an assembler_agent is refused, not executed.
+Faults are injected through its `<robot_name>/inject_fault` service (`fjsp_planner.faults`).
 """
 
 import sys
 
 import rclpy
-from rclpy.exceptions import InvalidParameterTypeException
+from rclpy.exceptions import InvalidParameterTypeException, InvalidServiceNameException
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.time import Time as RosTime
 
 from fjsp_msgs.msg import Plan, RobotState, TaskEvent
+from fjsp_msgs.srv import InjectFault
 from fjsp_planner.nodes.interfaces import (
     EVENTS_QOS,
+    INJECT_FAULT_SERVICE,
     LATCHED_QOS,
     PLAN_TOPIC,
     ROBOT_STATES_TOPIC,
     TASK_EVENTS_TOPIC,
 )
-from robot_agents.execution import EventKind, Mode, RobotExecution, Task
+from robot_agents.execution import EventKind, FaultResult, Mode, RobotExecution, Task
 
 MODE_TO_MSG = {
     Mode.IDLE: RobotState.MODE_IDLE,
@@ -28,6 +31,7 @@ MODE_TO_MSG = {
     Mode.WAITING: RobotState.MODE_WAITING,
     Mode.WORKING: RobotState.MODE_WORKING,
     Mode.HOLDING: RobotState.MODE_HOLDING,
+    Mode.FAILED: RobotState.MODE_FAILED,
 }
 KIND_TO_MSG = {
     EventKind.ARRIVED: TaskEvent.KIND_ARRIVED,
@@ -69,6 +73,12 @@ class RobotAgent(Node):
         self.event_pub = self.create_publisher(TaskEvent, TASK_EVENTS_TOPIC, EVENTS_QOS)
         self.create_subscription(Plan, PLAN_TOPIC, self.on_plan, LATCHED_QOS)
         self.create_subscription(TaskEvent, TASK_EVENTS_TOPIC, self.on_event, EVENTS_QOS)
+        try:
+            self.create_service(InjectFault, f'{self.robot}/{INJECT_FAULT_SERVICE}',
+                                self.on_fault)
+        except InvalidServiceNameException:
+            raise ParameterError(f"parameter 'robot_name' must be usable in a ROS name "
+                                 f'(letters, digits, underscores), got {self.robot!r}') from None
         self.create_timer(tick_period, self.tick)
         self.create_timer(heartbeat_period, self.publish_state)
         self.publish_state()
@@ -114,36 +124,70 @@ class RobotAgent(Node):
                         f'assumes {msg.time_scale}: this robot runs off the planned pace')
         self.scale = self.time_scale or msg.time_scale
         self.mission_start = RosTime.from_msg(msg.mission_start)
-        job_robots = {}
+        job_robots, continued = {}, set()
         for robot_plan in msg.robots:
             for t in robot_plan.tasks:
                 job_robots.setdefault(t.job, set()).add(robot_plan.robot)
+                if t.continued:
+                    continued.add(t.job)
         tasks = [Task(job=t.job, operation_type=t.operation_type, location=t.location,
                       travel_start=t.travel_start, arrival=t.arrival, start=t.start,
                       operation_end=t.operation_end, end=t.end,
                       co_workers=tuple(t.co_workers), predecessors=tuple(t.predecessors),
                       held_into_next=t.held_into_next)
                  for t in mine[0].tasks]
-        now = max(self.now_units(), 0.0)
-        events = self.execution.set_plan(msg.revision, tasks, job_robots, now)
+        now = self.now_units()
+        if now >= 0:
+            # What was due before the new revision happened under the old one.
+            self.publish_events(self.execution.step(now))
+        self.execution.set_plan(msg.revision, tasks, job_robots, max(now, 0.0),
+                                continued=continued)
         log.info(f'following plan revision {msg.revision}: '
                  + (' -> '.join(t.job for t in tasks) or 'no task'))
-        self.publish_events(events)
         self.publish_state()  # a new revision is a transition, even before the mission start
         self.tick()
 
     def on_event(self, msg: TaskEvent) -> None:
         if msg.robot == self.robot and msg.kind != TaskEvent.KIND_JOB_DONE:
             return
+        execution, revision = self.execution, msg.plan_revision
         if msg.kind == TaskEvent.KIND_ARRIVED:
-            self.execution.arrived(msg.robot, msg.job, msg.time)
+            used = execution.arrived(msg.robot, msg.job, msg.time, revision)
         elif msg.kind == TaskEvent.KIND_OPERATION_DONE:
-            self.execution.operation_done(msg.robot, msg.job, msg.time)
+            used = execution.operation_done(msg.robot, msg.job, msg.time, revision)
         elif msg.kind == TaskEvent.KIND_JOB_DONE:
-            self.execution.job_done(msg.job, msg.time)
+            used = execution.job_done(msg.job, msg.time, revision)
         elif msg.kind == TaskEvent.KIND_ABORTED:
-            self.execution.aborted(msg.job)
+            used = execution.aborted(msg.job, revision)
+        else:
+            return
+        if not used:
+            self.get_logger().debug(f"ignoring event '{msg.event_id}' of revision {revision}: "
+                                    f"job '{msg.job}' was restarted since")
         self.tick()
+
+    def on_fault(self, request, response):
+        now = self.now_units()
+        # Before the first plan nothing runs, so the time of a fault does not matter.
+        now = 0.0 if now is None else max(now, 0.0)
+        execution = self.execution
+        if request.fault == InjectFault.Request.FAULT_FAIL:
+            result = execution.fail(now)
+        elif request.fault == InjectFault.Request.FAULT_RECOVER:
+            result = execution.recover(now)
+        elif request.fault == InjectFault.Request.FAULT_DELAY:
+            result = execution.delay(request.factor, now)
+        else:
+            result = FaultResult(False, f"robot '{self.robot}': unknown fault "
+                                        f'{request.fault} (FAIL=0, RECOVER=1, DELAY=2)')
+        self.publish_events(result.events)
+        if result.accepted:
+            self.get_logger().warning(f'fault injected: {result.message}')
+            self.publish_state()
+        else:
+            self.get_logger().warning(result.message)
+        response.success, response.message = result.accepted, result.message
+        return response
 
     def tick(self) -> None:
         now = self.now_units()

@@ -5,11 +5,16 @@ at `d` arrives at `d + leg`, and a job starts when its last robot arrived and it
 predecessor completed. Everyone derives those instants from the same reported facts, so the
 robots of a job start at the same schedule time even though each learns of the last arrival a
 few milliseconds apart. Wall-clock lateness shows up as a robot acting later than its logical
-time, never as a timeline that breaks the schedule's constraints.
+time, never as a timeline that breaks the schedule's constraints. What the robot learns at
+`now` (a new plan, a recovery) cannot make it act before `now`.
+
+Every fact carries the plan revision it was reported under. A revision that restarts a job
+(its task is not `continued`) voids what older revisions reported about it: the job is redone
+from scratch, so its old arrivals and completions must not start or end the new attempt.
 """
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from enum import StrEnum
 
 # Reported ends are rounded up onto this grid (schedule units) so that float rounding never
@@ -28,6 +33,7 @@ class Mode(StrEnum):
     WAITING = 'waiting'
     WORKING = 'working'
     HOLDING = 'holding'
+    FAILED = 'failed'
 
 
 class EventKind(StrEnum):
@@ -72,21 +78,41 @@ class Event:
     reason: str = ''
 
 
+@dataclass(frozen=True)
+class FaultResult:
+    """The answer to an injected fault: refused faults change nothing."""
+
+    accepted: bool
+    message: str
+    """What happened, or why not; names the robot and the fault."""
+    events: list[Event] = field(default_factory=list)
+    """Events due by the fault's time, then the fault's own (an abort)."""
+
+
+@dataclass(frozen=True)
+class _Fact:
+    time: float
+    revision: int
+    """The plan revision it was reported under."""
+
+
 class _Phase(StrEnum):
     NEXT = 'next'          # choose the next task
-    TRAVEL = 'travel'
+    TRAVEL = 'travel'      # to the current task's location
+    TRANSIT = 'transit'    # ending a leg no task needs any more (new revision, recovery)
     WAIT = 'wait'          # at the job, waiting for predecessors and co-workers
     WORK = 'work'
     FINISH = 'finish'      # own operation done, the job's other operations still running
     DONE = 'done'          # sequence exhausted
+    FAILED = 'failed'
 
 
 class RobotExecution:
     """A robot following the latest plan revision it was given.
 
-    Feed it plans (`set_plan`) and the facts other robots and the planner report
-    (`arrived`, `operation_done`, `job_done`, `aborted`); `step(now)` moves it as far as
-    `now` allows and returns the events it produced.
+    Feed it plans (`set_plan`), the facts other robots and the planner report (`arrived`,
+    `operation_done`, `job_done`, `aborted`) and faults (`fail`, `recover`, `delay`);
+    `step(now)` moves it as far as `now` allows and returns the events it produced.
     """
 
     def __init__(self, robot: str):
@@ -98,14 +124,23 @@ class RobotExecution:
         self._phase = _Phase.DONE
         self._index = 0
         self._free_at = 0.0
+        self._not_before = 0.0
+        """When the latest plan arrived: nothing it orders can begin earlier."""
         self._phase_start = math.nan
         self._phase_end = math.nan
-        self._holding = False
+        self._holding = ''
+        """The done jig job whose part the robot holds into its next job ('' if none)."""
+        self._factor = 1.0
+        """Duration factor of the next operation the robot begins (delay faults)."""
+        self._work_factor = 1.0
+        self._failed_at = math.nan
+        self._failed_mid_leg = False
         self._job_robots: dict[str, frozenset[str]] = {}
-        self._arrived: dict[tuple[str, str], float] = {}
-        self._operation_done: dict[tuple[str, str], float] = {}
-        self._job_done: dict[str, float] = {}
-        self._own_done: set[str] = set()
+        self._arrived: dict[tuple[str, str], _Fact] = {}
+        self._operation_done: dict[tuple[str, str], _Fact] = {}
+        self._job_done: dict[str, _Fact] = {}
+        self._restarted: dict[str, int] = {}
+        """Job -> the latest revision that restarted it; older reports about it are void."""
         self._attempts: dict[str, int] = {}
 
     # --- what the robot is doing -------------------------------------------------------
@@ -123,7 +158,9 @@ class RobotExecution:
 
     @property
     def mode(self) -> Mode:
-        if self._phase == _Phase.TRAVEL:
+        if self._phase == _Phase.FAILED:
+            return Mode.FAILED
+        if self._phase in (_Phase.TRAVEL, _Phase.TRANSIT):
             return Mode.TRAVELLING
         if self._phase == _Phase.WORK:
             return Mode.WORKING
@@ -135,13 +172,16 @@ class RobotExecution:
 
     @property
     def busy_until(self) -> float:
-        """When the current leg or operation ends (NaN when waiting or idle)."""
-        if self._phase in (_Phase.TRAVEL, _Phase.WORK):
+        """When the current leg or operation ends (NaN when waiting, idle or failed)."""
+        if self._phase in (_Phase.TRAVEL, _Phase.TRANSIT, _Phase.WORK):
             return self._phase_end
         return math.nan
 
     def progress(self, now: float) -> float:
-        if self._phase not in (_Phase.TRAVEL, _Phase.WORK):
+        """0..1 of the current leg or operation; of the leg it stopped on, once failed."""
+        if self._phase == _Phase.FAILED and self._failed_mid_leg:
+            now = self._failed_at
+        elif self._phase not in (_Phase.TRAVEL, _Phase.TRANSIT, _Phase.WORK):
             return 0.0
         span = self._phase_end - self._phase_start
         if span <= 0:
@@ -152,65 +192,179 @@ class RobotExecution:
     def finished(self) -> bool:
         return self._phase == _Phase.DONE and self.revision > 0
 
-    # --- inputs ----------------------------------------------------------------------
+    # --- plans -----------------------------------------------------------------------
 
-    def set_plan(self, revision: int, tasks, job_robots, now: float) -> list[Event]:
-        """Follow a newer revision from `now`; returns the events it causes (an abort, if any).
+    def set_plan(self, revision: int, tasks, job_robots, now: float, *, continued) -> None:
+        """Follow a newer revision from `now`.
 
-        The job the robot is on continues if the new plan still gives it to this robot;
-        otherwise the robot leaves it and follows the new sequence from where it is.
+        `job_robots` maps every job of the plan to its robots; `continued` names the jobs
+        that go on as they are. Every other job of the plan starts afresh: what older
+        revisions reported about it is dropped, and later reports of older revisions about it
+        are ignored. The robot goes on with its current job only if that job is continued and
+        is the first unfinished task of its new sequence; otherwise it ends the leg it is on
+        (if any) and follows the new sequence from there, abandoning the job it was on without
+        an event (the planner ordered it). A failed robot takes the revision but does nothing.
         Raises `ValueError` for a revision that is not newer than the one followed.
         """
         if revision <= self.revision:
             raise ValueError(f'plan revision {revision} is not newer than revision '
                              f'{self.revision} already followed')
         tasks = tuple(tasks)
-        events = []
+        continued = frozenset(continued)
         current = self.task
-        if self.revision == 0:
-            # A robot that joins a running mission cannot have done anything before it did.
-            self._free_at = max(self._free_at, now)
         self.revision = revision
         self._job_robots = {job: frozenset(robots) for job, robots in job_robots.items()}
-        jobs = [t.job for t in tasks]
-        if current is not None and current.job in jobs:
-            self.tasks = tasks
-            self._index = jobs.index(current.job)
-            return events
-        if current is not None:
-            if self._phase == _Phase.TRAVEL:
-                # It cannot vanish mid-leg: it ends the leg, then goes on from there.
-                self.location = self.destination
-                self._free_at = self._phase_end
-            else:
-                self._free_at = max(self._free_at, now)
-                if self._phase == _Phase.WORK:
-                    events.append(Event(EventKind.ABORTED, current.job, now,
-                                        self._attempts[current.job],
-                                        f'not in plan revision {revision}'))
-            self.destination = ''
-            self._holding = False
+        self._not_before = max(self._not_before, now)
+        for job in (set(self._job_robots) | {t.job for t in tasks}) - continued:
+            self._restart(job, revision)
         self.tasks = tasks
+        if self._phase == _Phase.FAILED:
+            self._index = 0
+            return
+        index = self._continued_index(current, continued)
+        if index is not None:
+            self._index = index
+            return
+        if not self._still_holding():
+            self._holding = ''
         self._index = 0
-        self._phase = _Phase.NEXT
-        return events
+        if self._phase in (_Phase.TRAVEL, _Phase.TRANSIT):
+            # It cannot vanish mid-leg: it ends the leg, then goes on from there.
+            self._phase = _Phase.TRANSIT
+        else:
+            self.destination = ''
+            self._phase = _Phase.NEXT
 
-    def arrived(self, robot: str, job: str, time: float) -> None:
-        self._arrived.setdefault((robot, job), time)
+    def _continued_index(self, current: Task | None, continued) -> int | None:
+        """Where the current job is in the new sequence, if the robot goes on with it."""
+        if current is None or current.job not in continued:
+            return None
+        for i, task in enumerate(self.tasks):
+            if task.job == current.job:
+                return i
+            if not self._finished(task.job):
+                return None
+        return None
 
-    def operation_done(self, robot: str, job: str, time: float) -> None:
-        self._operation_done.setdefault((robot, job), time)
+    def _still_holding(self) -> bool:
+        """The new sequence keeps the held jig job, done, right before its first open task."""
+        for before, task in zip((None, *self.tasks), self.tasks, strict=False):
+            if not self._finished(task.job):
+                return (before is not None and before.job == self._holding
+                        and before.held_into_next)
+        return False
 
-    def job_done(self, job: str, time: float) -> None:
-        self._job_done.setdefault(job, time)
+    def _restart(self, job: str, revision: int) -> None:
+        self._restarted[job] = revision
+        self._forget(job, lambda fact: fact.revision < revision)
 
-    def aborted(self, job: str) -> None:
-        """The job will be redone from scratch: what was reported about it no longer holds."""
+    def _forget(self, job: str, void) -> None:
         for facts in (self._arrived, self._operation_done):
-            for key in [k for k in facts if k[1] == job]:
+            for key in [k for k, fact in facts.items() if k[1] == job and void(fact)]:
                 del facts[key]
-        self._job_done.pop(job, None)
-        self._own_done.discard(job)
+        if job in self._job_done and void(self._job_done[job]):
+            del self._job_done[job]
+
+    # --- facts reported by the others ------------------------------------------------
+
+    def arrived(self, robot: str, job: str, time: float, revision: int) -> bool:
+        """Record a report; False if it was ignored as a report about a restarted job."""
+        return self._record(self._arrived, (robot, job), job, time, revision)
+
+    def operation_done(self, robot: str, job: str, time: float, revision: int) -> bool:
+        return self._record(self._operation_done, (robot, job), job, time, revision)
+
+    def job_done(self, job: str, time: float, revision: int) -> bool:
+        return self._record(self._job_done, job, job, time, revision)
+
+    def aborted(self, job: str, revision: int) -> bool:
+        """The job will be redone from scratch: what was reported about it no longer holds."""
+        if revision < self._restarted.get(job, 0):
+            return False
+        self._forget(job, lambda fact: fact.revision <= revision)
+        return True
+
+    def _record(self, facts, key, job: str, time: float, revision: int) -> bool:
+        if revision < self._restarted.get(job, 0):
+            return False
+        # Of two reports of the same fact the first counts, unless the other one comes from a
+        # newer revision (a robot redoing a restarted job may report before this robot
+        # learns of the restart).
+        known = facts.get(key)
+        if known is None or revision > known.revision:
+            facts[key] = _Fact(time, revision)
+        return True
+
+    # --- faults ----------------------------------------------------------------------
+
+    def fail(self, now: float) -> FaultResult:
+        """Stop at `now`: abort the operation under way; a leg is frozen where it is."""
+        if self._phase == _Phase.FAILED:
+            return self._refuse('fail', 'has already failed')
+        events = self.step(now)
+        message = f"robot '{self.robot}' failed at t={now:.2f}"
+        if self._phase == _Phase.WORK:
+            job = self.task.job
+            events.append(Event(EventKind.ABORTED, job, now, self._attempts[job],
+                                f"robot '{self.robot}' failed"))
+            self.aborted(job, self.revision)
+            message += f", aborting its operation of job '{job}'"
+        self._failed_mid_leg = self._phase in (_Phase.TRAVEL, _Phase.TRANSIT)
+        if self._failed_mid_leg:
+            message += (f" on its way from '{self.location}' to '{self.destination}' "
+                        f'({self.progress(now):.0%} done)')
+        else:
+            self.destination = ''
+            message += f" at '{self.location}'" if self.location else ''
+        self._phase, self._failed_at, self._holding = _Phase.FAILED, now, ''
+        return FaultResult(True, message, events)
+
+    def recover(self, now: float) -> FaultResult:
+        """Back in service at `now` where it stopped, its old tasks dropped; a frozen leg
+        resumes to its destination."""
+        if self._phase != _Phase.FAILED:
+            return self._refuse('recover', 'has not failed')
+        # The planner re-plans on a recovery; until then the robot has nothing to do.
+        self.tasks, self._index, self._free_at = (), 0, now
+        message = f"robot '{self.robot}' recovered at t={now:.2f}"
+        if self._failed_mid_leg:
+            self._phase = _Phase.TRANSIT
+            self._phase_start += now - self._failed_at
+            self._phase_end = later(now + self._phase_end - self._failed_at)
+            message += (f", resuming its leg from '{self.location}' to '{self.destination}' "
+                        f'(arrival at t={self._phase_end:.2f})')
+        else:
+            self._phase = _Phase.NEXT
+            message += f" at '{self.location}'" if self.location else ''
+        return FaultResult(True, message)
+
+    def delay(self, factor: float, now: float) -> FaultResult:
+        """Multiply the duration of the operation under way, or else of the next one."""
+        if not (math.isfinite(factor) and factor > 0):
+            return self._refuse('delay', f'needs a finite factor > 0, got {factor:g}')
+        if self._phase == _Phase.FAILED:
+            return self._refuse('delay', 'has failed')
+        events = self.step(now)
+        if self._phase == _Phase.WORK:
+            self._work_factor *= factor
+            end = self._phase_start + self.task.duration * self._work_factor
+            # A speed-up cannot end the operation before it was ordered.
+            self._phase_end = later(max(end, now))
+            return FaultResult(True, f"robot '{self.robot}': operation of job "
+                                     f"'{self.task.job}' now ends at t={self._phase_end:.2f}",
+                               events)
+        if not self._work_left():
+            return self._refuse('delay', 'has no operation left to do', events)
+        self._factor *= factor
+        return FaultResult(True, f"robot '{self.robot}': the next operation it begins takes "
+                                 f'{self._factor:g} times its duration', events)
+
+    def _refuse(self, fault: str, why: str, events=()) -> FaultResult:
+        return FaultResult(False, f"{fault} refused: robot '{self.robot}' {why}", list(events))
+
+    def _work_left(self) -> bool:
+        after = self._index + 1 if self._phase == _Phase.FINISH else self._index
+        return any(not self._finished(t.job) for t in self.tasks[after:])
 
     # --- stepping --------------------------------------------------------------------
 
@@ -224,11 +378,17 @@ class RobotExecution:
     def _advance(self, now: float, events: list[Event]) -> bool:
         if self._phase == _Phase.NEXT:
             return self._next()
+        if self._phase == _Phase.TRANSIT and now >= self._phase_end:
+            self.location, self.destination = self.destination, ''
+            self._free_at = self._phase_end
+            self._phase = _Phase.NEXT
+            return True
         if self._phase == _Phase.TRAVEL and now >= self._phase_end:
             task = self.task
             self.location, self.destination = task.location, ''
             self._phase = _Phase.WAIT
-            self._arrived.setdefault((self.robot, task.job), self._phase_end)
+            self._record(self._arrived, (self.robot, task.job), task.job, self._phase_end,
+                         self.revision)
             events.append(Event(EventKind.ARRIVED, task.job, self._phase_end,
                                 self._attempts[task.job]))
             return True
@@ -237,14 +397,16 @@ class RobotExecution:
             if start is None or now < start:
                 return False
             task = self.task
-            self._phase, self._holding = _Phase.WORK, False
-            self._phase_start, self._phase_end = start, later(start + task.duration)
+            self._phase, self._holding = _Phase.WORK, ''
+            self._work_factor, self._factor = self._factor, 1.0
+            self._phase_start = start
+            self._phase_end = later(start + task.duration * self._work_factor)
             events.append(Event(EventKind.STARTED, task.job, start, self._attempts[task.job]))
             return True
         if self._phase == _Phase.WORK and now >= self._phase_end:
             task = self.task
-            self._operation_done.setdefault((self.robot, task.job), self._phase_end)
-            self._own_done.add(task.job)
+            self._record(self._operation_done, (self.robot, task.job), task.job,
+                         self._phase_end, self.revision)
             self._phase = _Phase.FINISH
             events.append(Event(EventKind.OPERATION_DONE, task.job, self._phase_end,
                                 self._attempts[task.job]))
@@ -254,7 +416,7 @@ class RobotExecution:
             if end is None or now < end:
                 return False
             self._free_at = end
-            self._holding = self.task.held_into_next
+            self._holding = self.task.job if self.task.held_into_next else ''
             self._index += 1
             self._phase = _Phase.NEXT
             return True
@@ -264,11 +426,11 @@ class RobotExecution:
         while self._index < len(self.tasks) and self._finished(self.tasks[self._index].job):
             self._index += 1
         if self._index >= len(self.tasks):
-            self._phase, self._holding = _Phase.DONE, False
+            self._phase, self._holding = _Phase.DONE, ''
             return False
         task = self.tasks[self._index]
         self._attempts[task.job] = self._attempts.get(task.job, 0) + 1
-        departure = max(self._free_at, 0.0)
+        departure = max(self._free_at, self._not_before)
         leg = 0.0 if self._holding or not self.location else max(task.leg, 0.0)
         self._phase = _Phase.TRAVEL
         self._phase_start = departure
@@ -277,7 +439,7 @@ class RobotExecution:
         return True
 
     def _finished(self, job: str) -> bool:
-        return job in self._own_done or job in self._job_done
+        return (self.robot, job) in self._operation_done or job in self._job_done
 
     def _start_time(self, task: Task) -> float | None:
         """When the job can start: its last robot arrived and last predecessor completed."""
@@ -285,7 +447,7 @@ class RobotExecution:
         for robot in self._job_robots.get(task.job, frozenset({self.robot})) | {self.robot}:
             if (robot, task.job) not in self._arrived:
                 return None
-            times.append(self._arrived[robot, task.job])
+            times.append(self._arrived[robot, task.job].time)
         for job in task.predecessors:
             end = self._job_end(job)
             if end is None:
@@ -296,8 +458,8 @@ class RobotExecution:
     def _job_end(self, job: str) -> float | None:
         """A job is complete when the planner says so or every robot on it reported done."""
         if job in self._job_done:
-            return self._job_done[job]
+            return self._job_done[job].time
         robots = self._job_robots.get(job)
         if not robots or any((r, job) not in self._operation_done for r in robots):
             return None
-        return max(self._operation_done[r, job] for r in robots)
+        return max(self._operation_done[r, job].time for r in robots)
