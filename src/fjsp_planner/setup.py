@@ -24,6 +24,7 @@ setup(
             'fjsp-solve = fjsp_planner.cli:main',
             'planner_node = fjsp_planner.nodes.planner:main',
             'monitor_node = fjsp_planner.nodes.monitor:main',
+            'inject_fault = fjsp_planner.faults:main',
         ],
     },
 )

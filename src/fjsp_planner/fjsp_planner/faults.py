@@ -1,0 +1,188 @@
+"""Inject off-nominal events into a running mission: make a robot fail, recover, or run slower.
+
+Each robot agent serves `<robot>/inject_fault` (`fjsp_msgs/srv/InjectFault`). From a test
+script:
+
+    from fjsp_planner.faults import FaultError, inject_fault
+
+    inject_fault('MARC1', 'fail')          # abort what it does, stop where it is
+    inject_fault('LSMS', 'delay', 2.0)     # its current (or next) operation takes twice as long
+    inject_fault('MARC1', 'recover')       # back in service where it stopped
+
+and from a shell:
+
+    ros2 run fjsp_planner inject_fault MARC1 delay --factor 2 [--timeout 5]
+
+`inject_fault` returns the agent's answer, or raises `FaultError` with a message saying what
+went wrong (bad arguments, nobody answering, or the agent's refusal). ROS is imported only
+when a call is made, so arguments can be checked without a built workspace.
+"""
+
+import argparse
+import math
+import os
+import sys
+import threading
+from contextlib import ExitStack, contextmanager
+
+FAULTS = ('fail', 'recover', 'delay')
+
+
+class FaultError(ValueError):
+    """A fault that was not injected: bad arguments, no agent answering, or refused."""
+
+
+def check_fault(fault: str, factor: float | None) -> float:
+    """The factor to send for `fault` (0 when it takes none); FaultError if they do not fit."""
+    if fault not in FAULTS:
+        raise FaultError(f'unknown fault {fault!r}: expected one of {", ".join(FAULTS)}')
+    if fault != 'delay':
+        if factor is not None:
+            raise FaultError(f"fault '{fault}' takes no factor (got {factor!r}); only "
+                             "'delay' does")
+        return 0.0
+    if factor is None:
+        raise FaultError("fault 'delay' needs a factor > 0 (e.g. 2 to double durations)")
+    try:
+        factor = float(factor)
+    except (TypeError, ValueError):
+        raise FaultError(f"fault 'delay': factor must be a number, got {factor!r}") from None
+    if not (math.isfinite(factor) and factor > 0):
+        raise FaultError(f"fault 'delay': factor must be a finite number > 0, got {factor:g}")
+    return factor
+
+
+def inject_fault(robot: str, fault: str, factor: float | None = None, *, node=None,
+                 timeout: float = 5.0) -> str:
+    """Inject `fault` ('fail', 'recover' or 'delay' with `factor`) into `robot`'s agent.
+
+    Returns the agent's message. Waits up to `timeout` seconds for the agent's service to
+    appear and as long again for its answer. With `node` (an rclpy node), calls through it:
+    it is spun here unless an executor already spins it, so call from outside that
+    executor's callbacks. Without, uses a private node in a private context, so it works
+    whether or not the caller has called `rclpy.init`, and never touches the caller's
+    context. Both honour ROS_DOMAIN_ID and the other ROS environment variables.
+    """
+    factor = check_fault(fault, factor)
+    if not (isinstance(timeout, int | float) and math.isfinite(timeout) and timeout > 0):
+        raise FaultError(f'timeout must be a number of seconds > 0, got {timeout!r}')
+    if node is not None:
+        return _call(node, robot, fault, factor, timeout)
+    with _own_node(args=[]) as own:
+        return _call(own, robot, fault, factor, timeout)
+
+
+@contextmanager
+def _own_node(args):
+    """A node in a private context, whatever the caller did with rclpy's default one."""
+    import rclpy
+
+    context = rclpy.Context()
+    try:
+        rclpy.init(args=args, context=context)
+    except RuntimeError as error:  # rclpy's RCLError: rcl could not parse the ROS arguments
+        raise FaultError(f'bad ROS arguments: {error}') from None
+    try:
+        node = rclpy.create_node(f'inject_fault_{os.getpid()}', context=context)
+        try:
+            yield node
+        finally:
+            node.destroy_node()
+    finally:
+        rclpy.try_shutdown(context=context)
+
+
+def _call(node, robot, fault, factor, timeout) -> str:
+    from rclpy.exceptions import InvalidServiceNameException
+
+    from fjsp_msgs.srv import InjectFault
+    from fjsp_planner.nodes.interfaces import INJECT_FAULT_SERVICE
+
+    try:
+        client = node.create_client(InjectFault, f'{robot}/{INJECT_FAULT_SERVICE}')
+    except InvalidServiceNameException:
+        raise FaultError(f'{robot!r} is not a robot name (letters, digits and underscores, '
+                         'not starting with a digit)') from None
+    try:
+        name = node.resolve_service_name(client.srv_name)
+        if not client.wait_for_service(timeout_sec=timeout):
+            raise FaultError(f"no agent serves '{name}' (waited {timeout:g} s): is the robot's "
+                             'agent running, with the same ROS_DOMAIN_ID?')
+        request = InjectFault.Request(
+            fault=getattr(InjectFault.Request, f'FAULT_{fault.upper()}'), factor=factor)
+        future = client.call_async(request)
+        if not _wait(node, future, timeout):
+            client.remove_pending_request(future)
+            raise FaultError(f"'{name}' did not answer within {timeout:g} s")
+        response = future.result()
+    finally:
+        node.destroy_client(client)
+    if not response.success:
+        raise FaultError(response.message)
+    return response.message
+
+
+def _wait(node, future, timeout) -> bool:
+    """Wait for the answer: spin `node` here unless an executor already does."""
+    if node.executor is None:
+        from rclpy.executors import SingleThreadedExecutor
+
+        executor = SingleThreadedExecutor(context=node.context)
+        try:
+            executor.add_node(node)
+            executor.spin_until_future_complete(future, timeout_sec=timeout)
+        finally:
+            executor.remove_node(node)
+            node.executor = None  # remove_node leaves the node pointing at this executor
+            executor.shutdown()
+    else:
+        answered = threading.Event()
+        future.add_done_callback(lambda _: answered.set())
+        answered.wait(timeout)
+    return future.done()
+
+
+def main(argv=None) -> int:
+    """`inject_fault ROBOT fail|recover|delay [--factor F] [--timeout S] [--ros-args ...]`:
+    exit 0 when the agent accepted, 1 when it refused or nobody answered, 2 for bad
+    arguments."""
+    from rclpy.utilities import remove_ros_args
+
+    argv = sys.argv[1:] if argv is None else list(argv)
+    parser = argparse.ArgumentParser(
+        prog='inject_fault',
+        description="Make a robot agent fail, recover, or run slower (its "
+                    "'<robot>/inject_fault' service).")
+    parser.add_argument('robot', help='robot name, e.g. MARC1')
+    parser.add_argument('fault', choices=FAULTS)
+    parser.add_argument('--factor', type=float,
+                        help="delay only: multiply the current (or next) operation's "
+                             'duration by F (> 0)')
+    parser.add_argument('--timeout', type=float, default=5.0, metavar='S',
+                        help='seconds to wait for the agent to appear, and then to answer '
+                             '(default 5)')
+    args = parser.parse_args(remove_ros_args(['inject_fault', *argv])[1:])
+    if not (math.isfinite(args.timeout) and args.timeout > 0):
+        parser.error(f'--timeout must be a number of seconds > 0, got {args.timeout:g}')
+    try:
+        factor = check_fault(args.fault, args.factor)
+    except FaultError as error:
+        parser.error(str(error))
+    try:
+        with ExitStack() as stack:
+            try:
+                # rclpy reads the --ros-args part (remappings, log level, ...) itself.
+                node = stack.enter_context(_own_node(['inject_fault', *argv]))
+            except FaultError as error:
+                parser.error(str(error))
+            print(_call(node, args.robot, args.fault, factor, args.timeout))
+    except FaultError as error:
+        print(f'inject_fault: {error}', file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        return 130
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())
