@@ -1,9 +1,10 @@
 """A fleet-level mission monitor built only on the public topics.
 
-It shows one line per robot and a mission line while the mission runs and, once it is
-complete, logs a summary and draws the planned and executed timelines into a PNG. Everything
-it needs is latched (plan, states, status) or kept for late joiners (task events), so it can
-be started at any time, even after the mission ended.
+It shows one line per robot and a mission line while the mission runs (a robot whose
+heartbeat is lost shows as offline) and, once it is complete, logs a summary and draws the
+planned and executed timelines into a PNG. Everything it needs is latched (plan, states,
+status) or kept for late joiners (task events), so it can be started at any time, even after
+the mission ended.
 """
 
 import math
@@ -14,6 +15,7 @@ import rclpy
 from rclpy.exceptions import InvalidParameterTypeException
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
+from rclpy.time import Time
 
 from fjsp_msgs.msg import MissionStatus, Plan, RobotState, TaskEvent
 from fjsp_planner.nodes.conversions import MODE_NAMES
@@ -46,14 +48,19 @@ class MonitorNode(Node):
         super().__init__('monitor')
         self.gantt_dir = Path(self.parameter('gantt_dir', '.')).expanduser()
         refresh_period = self.parameter('refresh_period', 1.0)
+        self.heartbeat_timeout = self.parameter('heartbeat_timeout', 1.0)
         self.exit_on_complete = self.parameter('exit_on_complete', False)
         # Events may reach a late joiner after the status saying the mission is complete.
         self.event_grace = self.parameter('event_grace', 3.0)
-        if not refresh_period > 0:
-            raise ParameterError(f"parameter 'refresh_period' must be > 0, got {refresh_period}")
+        for name, value in (('refresh_period', refresh_period),
+                            ('heartbeat_timeout', self.heartbeat_timeout)):
+            if not value > 0:
+                raise ParameterError(f"parameter '{name}' must be > 0, got {value}")
         self.plan: Plan | None = None
         self.status: MissionStatus | None = None
         self.robots: dict[str, RobotState] = {}
+        self.heard: dict[str, Time] = {}
+        """When each robot's latest state was received."""
         self.started: dict[tuple[str, str], float] = {}
         self.job_done: dict[str, float] = {}
         self.event_ids: set[str] = set()
@@ -82,6 +89,7 @@ class MonitorNode(Node):
 
     def on_robot(self, msg: RobotState) -> None:
         self.robots[msg.robot] = msg
+        self.heard[msg.robot] = self.get_clock().now()
 
     def on_status(self, msg: MissionStatus) -> None:
         self.status = msg
@@ -116,12 +124,19 @@ class MonitorNode(Node):
             lines += [f'  blocked: {reason}' for reason in s.blocked_reasons]
         names = [r.robot for r in self.plan.robots] if self.plan else []
         names += sorted(set(self.robots) - set(names))
+        now = self.get_clock().now()
         for name in names:
             r = self.robots.get(name)
             if r is None:
                 lines.append(f'  {name:<10} no report')
                 continue
-            mode = MODE_NAMES[r.mode] if r.mode < len(MODE_NAMES) else f'mode {r.mode}'
+            silent = (now - self.heard[name]).nanoseconds * 1e-9
+            if silent > self.heartbeat_timeout:
+                mode = 'offline'
+            elif r.mode < len(MODE_NAMES):
+                mode = MODE_NAMES[r.mode]
+            else:
+                mode = f'mode {r.mode}'
             where = (f'{r.location or "?"} -> {r.destination}' if r.destination
                      else r.location or '-')
             lines.append(f'  {name:<10} {mode:<10} job {r.current_job or "-":<4} '
