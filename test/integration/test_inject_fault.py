@@ -65,3 +65,23 @@ def test_helper_through_a_spun_node(launcher, observer):
     with pytest.raises(FaultError, match='has already failed'):
         inject_fault('MARC1', 'fail', node=observer.node, timeout=10)
     assert 'recovered' in inject_fault('MARC1', 'recover', node=observer.node, timeout=10)
+
+
+def test_monitor_shows_failed_then_offline(launcher, observer):
+    launcher.start_agent('MARC1')
+    launcher.start('monitor', 'fjsp_planner', 'monitor_node',
+                   [('refresh_period', 0.2), ('heartbeat_timeout', 0.6)])
+    observer.wait_for(mode_is(observer, RobotState.MODE_IDLE), 20, 'the MARC1 agent')
+    run(launcher, 'MARC1', 'fail')
+    wait_for_line(launcher, 'monitor', 'MARC1      failed')
+    launcher.kill('marc1_agent')
+    wait_for_line(launcher, 'monitor', 'MARC1      offline')
+
+
+def wait_for_line(launcher, name, text, timeout=10.0):
+    deadline = time.monotonic() + timeout
+    while text not in launcher.log(name):
+        if time.monotonic() > deadline:
+            pytest.fail(f'no {text!r} in the {name} log after {timeout:g} s:\n'
+                        + launcher.log(name))
+        time.sleep(0.1)
