@@ -50,8 +50,9 @@ def test_good_arguments_give_the_factor_to_send():
     (['MARC1', 'delay', '--factor', 'fast'], "invalid float value: 'fast'"),
     (['MARC1', 'fail', '--factor', '2'], "fault 'fail' takes no factor"),
     (['MARC1', 'fail', '--timeout', '0'], '--timeout must be a number of seconds > 0'),
+    (['MARC1', 'fail', '--ros-args', '-p'], 'bad ROS arguments: Failed to parse ROS arguments'),
 ], ids=['nothing', 'unknown fault', 'delay without factor', 'zero factor', 'factor not a number',
-        'factor for fail', 'zero timeout'])
+        'factor for fail', 'zero timeout', 'bad ROS arguments'])
 def test_command_line_exits_2_with_the_reason(args, message):
     done = subprocess.run([sys.executable, '-m', 'fjsp_planner.faults', *args],
                           capture_output=True, text=True, timeout=60,

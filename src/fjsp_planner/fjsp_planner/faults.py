@@ -23,7 +23,7 @@ import math
 import os
 import sys
 import threading
-from contextlib import ExitStack, contextmanager
+from contextlib import contextmanager
 
 FAULTS = ('fail', 'recover', 'delay')
 
@@ -80,8 +80,8 @@ def _own_node(args):
     context = rclpy.Context()
     try:
         rclpy.init(args=args, context=context)
-    except RuntimeError as error:  # rclpy's RCLError: rcl could not parse the ROS arguments
-        raise FaultError(f'bad ROS arguments: {error}') from None
+    except RuntimeError as error:  # rclpy's RCLError, e.g. for a bad ROS_DOMAIN_ID
+        raise FaultError(f'could not start ROS: {error}') from None
     try:
         node = rclpy.create_node(f'inject_fault_{os.getpid()}', context=context)
         try:
@@ -161,7 +161,11 @@ def main(argv=None) -> int:
     parser.add_argument('--timeout', type=float, default=5.0, metavar='S',
                         help='seconds to wait for the agent to appear, and then to answer '
                              '(default 5)')
-    args = parser.parse_args(remove_ros_args(['inject_fault', *argv])[1:])
+    try:
+        own_args = remove_ros_args(['inject_fault', *argv])[1:]
+    except RuntimeError as error:  # rclpy's RCLInvalidROSArgsError
+        parser.error(f'bad ROS arguments: {error}')
+    args = parser.parse_args(own_args)
     if not (math.isfinite(args.timeout) and args.timeout > 0):
         parser.error(f'--timeout must be a number of seconds > 0, got {args.timeout:g}')
     try:
@@ -169,12 +173,8 @@ def main(argv=None) -> int:
     except FaultError as error:
         parser.error(str(error))
     try:
-        with ExitStack() as stack:
-            try:
-                # rclpy reads the --ros-args part (remappings, log level, ...) itself.
-                node = stack.enter_context(_own_node(['inject_fault', *argv]))
-            except FaultError as error:
-                parser.error(str(error))
+        # rclpy reads the --ros-args part (remappings, log level, ...) itself.
+        with _own_node(['inject_fault', *argv]) as node:
             print(_call(node, args.robot, args.fault, factor, args.timeout))
     except FaultError as error:
         print(f'inject_fault: {error}', file=sys.stderr)
