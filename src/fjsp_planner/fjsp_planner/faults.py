@@ -61,7 +61,10 @@ def inject_fault(robot: str, fault: str, factor: float | None = None, *, node=No
     it is spun here unless an executor already spins it, so call from outside that
     executor's callbacks. Without, uses a private node in a private context, so it works
     whether or not the caller has called `rclpy.init`, and never touches the caller's
-    context. Both honour ROS_DOMAIN_ID and the other ROS environment variables.
+    context. Both honour ROS_DOMAIN_ID and the other ROS environment variables. A new
+    node (hence every private one) first waits for DDS discovery, up to about 3 s with
+    Fast DDS on localhost; a node that has been running a while gets its answer in
+    milliseconds, so pass one when the fault must land at a precise moment.
     """
     factor = check_fault(fault, factor)
     if not (isinstance(timeout, int | float) and math.isfinite(timeout) and timeout > 0):
