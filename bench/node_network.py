@@ -17,6 +17,7 @@ import sys
 import tempfile
 import threading
 import time
+from contextlib import closing
 from pathlib import Path
 
 import rclpy
@@ -105,26 +106,53 @@ class Recorder:
         rclpy.try_shutdown(context=self.context)
 
 
-def run(time_scale, domain, logs):
-    env = dict(os.environ, ROS_DOMAIN_ID=str(domain), ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
-    processes = {}
+class Nodes:
+    """Nodes started with `ros2 run` in one domain, each logging to `logs/<name>.log`;
+    interrupted (then killed if need be) on leaving the `with` block."""
 
-    def start(name, package, executable, *params):
+    def __init__(self, domain, logs):
+        self.env = dict(os.environ, ROS_DOMAIN_ID=str(domain),
+                        ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
+        self.logs = logs
+        self.processes = {}
+
+    def start(self, name, package, executable, *params):
         command = ['ros2', 'run', package, executable, '--ros-args', '-r', f'__node:={name}']
         for key, value in params:
             command += ['-p', f'{key}:={value}']
-        with (logs / f'{name}.log').open('w') as log:
-            processes[name] = subprocess.Popen(command, env=env, stdout=log,
-                                               stderr=subprocess.STDOUT, start_new_session=True)
+        with (self.logs / f'{name}.log').open('w') as log:
+            self.processes[name] = subprocess.Popen(
+                command, env=self.env, stdout=log, stderr=subprocess.STDOUT,
+                start_new_session=True)
 
-    recorder = Recorder(domain)
-    try:
+    def start_agents(self):
+        for robot, executable in ROBOTS:
+            self.start(f'{robot.lower()}_agent', 'robot_agents', executable,
+                       ('robot_name', robot))
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        for p in self.processes.values():
+            if p.poll() is None:
+                os.killpg(p.pid, signal.SIGINT)
+        for p in self.processes.values():
+            try:
+                p.wait(timeout=5)
+            except subprocess.TimeoutExpired:
+                os.killpg(p.pid, signal.SIGKILL)
+                p.wait()
+
+
+def run(time_scale, domain, logs):
+    with Nodes(domain, logs) as nodes, closing(Recorder(domain)) as recorder:
+        processes = nodes.processes
         # The recorder must hear each agent before the plan exists: a late-matched recorder
         # would only get the latest (heartbeat) state, not the transition it measures.
-        for robot, executable in ROBOTS:
-            start(f'{robot.lower()}_agent', 'robot_agents', executable, ('robot_name', robot))
+        nodes.start_agents()
         recorder.wait(lambda: len(recorder.heard) == len(ROBOTS), 30)
-        start('planner', 'fjsp_planner', 'planner_node', ('time_scale', time_scale))
+        nodes.start('planner', 'fjsp_planner', 'planner_node', ('time_scale', time_scale))
         recorder.wait(lambda: recorder.plan is not None, 60)
         recorder.wait(lambda: len(recorder.followed) == len(ROBOTS), 30)
         published = Time.from_msg(recorder.plan.stamp)
@@ -157,17 +185,6 @@ def run(time_scale, domain, logs):
         print(f'wall clock: mission start -> last job done {wall:.3f} s vs planned '
               f'{planned * time_scale:.3f} s (overhead {wall - planned * time_scale:+.3f} s, '
               f'{(wall / (planned * time_scale) - 1):+.1%})')
-    finally:
-        recorder.close()
-        for p in processes.values():
-            if p.poll() is None:
-                os.killpg(p.pid, signal.SIGINT)
-        for p in processes.values():
-            try:
-                p.wait(timeout=5)
-            except subprocess.TimeoutExpired:
-                os.killpg(p.pid, signal.SIGKILL)
-                p.wait()
 
 
 def main(argv):
