@@ -146,7 +146,11 @@ def test_two_failures_block_until_a_recovery(launcher, observer, problem):
                       'the mission to block')
     reasons = '\n'.join(observer.status.blocked_reasons)
     # Aa and Ab need two frame holders and a welder; only the Assembler and LSMS are left.
-    assert "job 'Aa' cannot be staffed" in reasons and "job 'Ab' cannot be staffed" in reasons
+    # Aa (planned 7 to 12) may be done already if the faults land late on a loaded machine.
+    done = {e.job for e in valid_events(observer.plans, observer.events)
+            if e.kind == TaskEvent.KIND_JOB_DONE}
+    assert "job 'Ab' cannot be staffed" in reasons, reasons
+    assert 'Aa' in done or "job 'Aa' cannot be staffed" in reasons, reasons
     assert 'needs 3 distinct robots' in reasons and 'MARC1' in reasons, reasons
     blocked_revision = latest_revision(observer)
     inject(observer, 'MARC2', 'recover')

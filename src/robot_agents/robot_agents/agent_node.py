@@ -7,9 +7,7 @@ Faults are injected through its `<robot_name>/inject_fault` service (`fjsp_plann
 
 import sys
 
-import rclpy
-from rclpy.exceptions import InvalidParameterTypeException, InvalidServiceNameException
-from rclpy.executors import ExternalShutdownException
+from rclpy.exceptions import InvalidServiceNameException
 from rclpy.node import Node
 from rclpy.time import Time as RosTime
 
@@ -23,6 +21,7 @@ from fjsp_planner.nodes.interfaces import (
     ROBOT_STATES_TOPIC,
     TASK_EVENTS_TOPIC,
 )
+from fjsp_planner.nodes.running import ParameterError, declared, run_node
 from robot_agents.execution import EventKind, FaultResult, Mode, RobotExecution, Task
 
 MODE_TO_MSG = {
@@ -41,18 +40,14 @@ KIND_TO_MSG = {
 }
 
 
-class ParameterError(ValueError):
-    """A node parameter with a value the node cannot run with."""
-
-
 class RobotAgent(Node):
     def __init__(self, robot_type: str):
         super().__init__(f'{robot_type.lower()}_agent')
         self.robot_type = robot_type
-        self.robot = self.parameter('robot_name', '')
-        self.time_scale = self.parameter('time_scale', 0.0)
-        tick_period = self.parameter('tick_period', 0.01)
-        heartbeat_period = self.parameter('heartbeat_period', 0.2)
+        self.robot = declared(self, 'robot_name', '')
+        self.time_scale = declared(self, 'time_scale', 0.0)
+        tick_period = declared(self, 'tick_period', 0.01)
+        heartbeat_period = declared(self, 'heartbeat_period', 0.2)
         if not self.robot:
             raise ParameterError("parameter 'robot_name' is required "
                                  '(e.g. --ros-args -p robot_name:=MARC1)')
@@ -83,13 +78,6 @@ class RobotAgent(Node):
         self.create_timer(heartbeat_period, self.publish_state)
         self.publish_state()
         self.get_logger().info(f"robot '{self.robot}' ({robot_type}) ready, waiting for a plan")
-
-    def parameter(self, name, default):
-        try:
-            return self.declare_parameter(name, default).value
-        except InvalidParameterTypeException as e:
-            raise ParameterError(f"parameter '{name}' must be a {type(default).__name__} "
-                                 f'like {default!r}: {e}') from None
 
     def now_units(self) -> float | None:
         """Schedule time since the mission start, or None before the first plan."""
@@ -225,22 +213,7 @@ class RobotAgent(Node):
 
 
 def run(robot_type: str, args=None) -> int:
-    rclpy.init(args=args)
-    node = None
-    code = 0
-    try:
-        node = RobotAgent(robot_type)
-        rclpy.spin(node)
-    except ParameterError as e:
-        rclpy.logging.get_logger(f'{robot_type.lower()}_agent').error(str(e))
-        code = 2
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
-    return code
+    return run_node(lambda: RobotAgent(robot_type), f'{robot_type.lower()}_agent', args)
 
 
 def assembler_main(args=None):

@@ -12,8 +12,6 @@ import sys
 from pathlib import Path
 
 import rclpy
-from rclpy.exceptions import InvalidParameterTypeException
-from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.time import Time
 
@@ -27,6 +25,7 @@ from fjsp_planner.nodes.interfaces import (
     ROBOT_STATES_TOPIC,
     TASK_EVENTS_TOPIC,
 )
+from fjsp_planner.nodes.running import ParameterError, declared, run_node
 
 STATE_NAMES = {
     MissionStatus.STATE_WAITING_FOR_ROBOTS: 'waiting for robots',
@@ -39,19 +38,15 @@ STATE_NAMES = {
 }
 
 
-class ParameterError(ValueError):
-    """A node parameter with a value the node cannot run with."""
-
-
 class MonitorNode(Node):
     def __init__(self):
         super().__init__('monitor')
-        self.gantt_dir = Path(self.parameter('gantt_dir', '.')).expanduser()
-        refresh_period = self.parameter('refresh_period', 1.0)
-        self.heartbeat_timeout = self.parameter('heartbeat_timeout', 1.0)
-        self.exit_on_complete = self.parameter('exit_on_complete', False)
+        self.gantt_dir = Path(declared(self, 'gantt_dir', '.')).expanduser()
+        refresh_period = declared(self, 'refresh_period', 1.0)
+        self.heartbeat_timeout = declared(self, 'heartbeat_timeout', 1.0)
+        self.exit_on_complete = declared(self, 'exit_on_complete', False)
         # Events may reach a late joiner after the status saying the mission is complete.
-        self.event_grace = self.parameter('event_grace', 3.0)
+        self.event_grace = declared(self, 'event_grace', 3.0)
         for name, value in (('refresh_period', refresh_period),
                             ('heartbeat_timeout', self.heartbeat_timeout)):
             if not value > 0:
@@ -75,13 +70,6 @@ class MonitorNode(Node):
                                  LATCHED_QOS)
         self.create_subscription(TaskEvent, TASK_EVENTS_TOPIC, self.on_event, EVENTS_QOS)
         self.create_timer(refresh_period, self.refresh)
-
-    def parameter(self, name, default):
-        try:
-            return self.declare_parameter(name, default).value
-        except InvalidParameterTypeException as e:
-            raise ParameterError(f"parameter '{name}' must be a {type(default).__name__} "
-                                 f'like {default!r}: {e}') from None
 
     def on_plan(self, msg: Plan) -> None:
         if self.plan is None or msg.revision > self.plan.revision:
@@ -227,21 +215,10 @@ def draw(plan: Plan, started, job_done, path: Path) -> None:
     plt.close(fig)
 
 
+def spin_until_finished(node: 'MonitorNode') -> None:
+    while rclpy.ok() and not node.finished:
+        rclpy.spin_once(node, timeout_sec=0.2)
+
+
 def main(args=None):
-    rclpy.init(args=args)
-    node = None
-    code = 0
-    try:
-        node = MonitorNode()
-        while rclpy.ok() and not node.finished:
-            rclpy.spin_once(node, timeout_sec=0.2)
-    except ParameterError as e:
-        rclpy.logging.get_logger('monitor').error(str(e))
-        code = 2
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
-    sys.exit(code)
+    sys.exit(run_node(MonitorNode, 'monitor', args, spin=spin_until_finished))

@@ -8,11 +8,8 @@ import time
 from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
 
-import rclpy
 from ament_index_python.packages import PackageNotFoundError, get_package_share_directory
 from rclpy.duration import Duration
-from rclpy.exceptions import InvalidParameterTypeException
-from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.time import Time
 
@@ -34,10 +31,7 @@ from fjsp_planner.nodes.interfaces import (
     ROBOT_STATES_TOPIC,
     TASK_EVENTS_TOPIC,
 )
-
-
-class ParameterError(ValueError):
-    """A node parameter with a value the node cannot run with."""
+from fjsp_planner.nodes.running import ParameterError, declared, run_node
 
 
 def default_scenario() -> str:
@@ -52,19 +46,19 @@ def default_scenario() -> str:
 class PlannerNode(Node):
     def __init__(self):
         super().__init__('planner')
-        scenario = self.parameter('scenario', '') or default_scenario()
-        panels = self.parameter('panels', 0)
-        shift = self.parameter('shift', -1.0)
-        self.solver = self.parameter('solver', 'cpsat')
-        self.time_limit = self.parameter('time_limit', 10.0)
-        self.replan_time_limit = self.parameter('replan_time_limit', 1.0)
-        self.workers = self.parameter('workers', 2)
-        self.heartbeat_timeout = self.parameter('heartbeat_timeout', 1.0)
-        self.delay_threshold = self.parameter('delay_threshold', 2.0)
-        self.time_scale = self.parameter('time_scale', 0.05)
-        self.robot_wait_timeout = self.parameter('robot_wait_timeout', 15.0)
-        self.start_delay = self.parameter('start_delay', 0.5)
-        status_period = self.parameter('status_period', 0.5)
+        scenario = declared(self, 'scenario', '') or default_scenario()
+        panels = declared(self, 'panels', 0)
+        shift = declared(self, 'shift', -1.0)
+        self.solver = declared(self, 'solver', 'cpsat')
+        self.time_limit = declared(self, 'time_limit', 10.0)
+        self.replan_time_limit = declared(self, 'replan_time_limit', 1.0)
+        self.workers = declared(self, 'workers', 2)
+        self.heartbeat_timeout = declared(self, 'heartbeat_timeout', 1.0)
+        self.delay_threshold = declared(self, 'delay_threshold', 2.0)
+        self.time_scale = declared(self, 'time_scale', 0.05)
+        self.robot_wait_timeout = declared(self, 'robot_wait_timeout', 15.0)
+        self.start_delay = declared(self, 'start_delay', 0.5)
+        status_period = declared(self, 'status_period', 0.5)
         for name, value, low in (('panels', panels, 0), ('time_limit', self.time_limit, 1e-9),
                                  ('replan_time_limit', self.replan_time_limit, 1e-9),
                                  ('heartbeat_timeout', self.heartbeat_timeout, 1e-9),
@@ -115,13 +109,6 @@ class PlannerNode(Node):
         self.create_timer(0.1, self.tick)
         self.create_timer(status_period, self.publish_periodic)
         self.publish_status()
-
-    def parameter(self, name, default):
-        try:
-            return self.declare_parameter(name, default).value
-        except InvalidParameterTypeException as e:
-            raise ParameterError(f"parameter '{name}' must be a {type(default).__name__} "
-                                 f'like {default!r}: {e}') from None
 
     # --- time ------------------------------------------------------------------------
 
@@ -420,19 +407,4 @@ class PlannerNode(Node):
 
 
 def main(args=None):
-    rclpy.init(args=args)
-    node = None
-    code = 0
-    try:
-        node = PlannerNode()
-        rclpy.spin(node)
-    except ParameterError as e:
-        rclpy.logging.get_logger('planner').error(str(e))
-        code = 2
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
-    sys.exit(code)
+    sys.exit(run_node(PlannerNode, 'planner', args))
