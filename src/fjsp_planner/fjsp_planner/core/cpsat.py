@@ -39,7 +39,8 @@ def solve_cpsat(problem: Problem, time_limit=10.0, workers=2, hint: Schedule | N
         model.add_hint(hint or upper_bound)
     model.model.minimize(model.makespan)
     setup = time.monotonic() - began
-    solver, recorder, status = _run(model.model, time_limit, workers, log)
+    # The limit bounds the whole call: a re-plan's latency is what the fleet waits for.
+    solver, recorder, status = _run(model.model, time_limit - setup, workers, log)
     if status in ('INFEASIBLE',):
         return Result(Status.INFEASIBLE, None, None, time.monotonic() - began, None, 'cpsat',
                       notes=model.notes)
@@ -52,7 +53,7 @@ def solve_cpsat(problem: Problem, time_limit=10.0, workers=2, hint: Schedule | N
     bound = Fraction(math.ceil(solver.best_objective_bound), model.scale)
     schedule = model.read(solver)
     if keep is not None and status == 'OPTIMAL':
-        keep_time = min(time_limit * KEEP_SHARE, time_limit - solver.wall_time)
+        keep_time = min(time_limit * KEEP_SHARE, time_limit - setup - solver.wall_time)
         if keep_time > 0.01:
             schedule = _keep_assignments(model, solver, best, keep, keep_time, workers,
                                          log) or schedule
