@@ -56,7 +56,10 @@ class FaultRecorder(Recorder):
         self.following.setdefault((msg.robot, msg.plan_revision), time.monotonic())
 
     def inject(self, robot, fault) -> tuple[float, bool, str]:
-        """Send the request; returns when it was sent and the agent's answer."""
+        """Send the request; returns when it was sent and the agent's answer.
+
+        Clients made once up front, not `faults.inject_fault`, which makes a client per
+        call: its service discovery (5-90 ms) would count in every latency."""
         sent = time.monotonic()
         future = self.clients[robot].call_async(InjectFault.Request(fault=fault))
         self.wait(future.done, 10)
