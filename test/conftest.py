@@ -4,7 +4,7 @@ import sys
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parent.parent
-for package in ('fjsp_planner', 'robot_agents'):
+for package in ('fjsp_common', 'fjsp_planner', 'robot_agents'):
     path = str(REPO / 'src' / package)
     if path not in sys.path:
         sys.path.insert(0, path)

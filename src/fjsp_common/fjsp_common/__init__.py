@@ -1,0 +1,6 @@
+"""The fleet's shared contract: what the planner, the robot agents and any monitor agree on.
+
+`vocabulary` (no ROS) names robot modes, event kinds and mission states once; `contract` maps
+them to the message constants and fixes topic names and QoS; `running` is how every node reads
+its parameters and runs.
+"""

@@ -1,0 +1,70 @@
+"""Topic names, QoS profiles and message constants the whole fleet agrees on.
+
+Names are relative, so a whole fleet can be moved into a namespace with `-r __ns:=/cell1`.
+Every vocabulary of `fjsp_common.vocabulary` is paired here with its message constants by
+name; a vocabulary word without a constant (or the reverse) fails at import, not in a mission.
+"""
+
+from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+
+from fjsp_common.vocabulary import EventKind, MissionEventKind, MissionState, RobotMode
+from fjsp_msgs.msg import MissionEvent, MissionStatus, RobotState, TaskEvent
+
+PLAN_TOPIC = 'plan'
+ROBOT_STATES_TOPIC = 'robot_states'
+JOB_STATES_TOPIC = 'job_states'
+TASK_EVENTS_TOPIC = 'task_events'
+MISSION_EVENTS_TOPIC = 'mission_events'
+MISSION_STATUS_TOPIC = 'mission_status'
+INJECT_FAULT_SERVICE = 'inject_fault'
+"""Served by each agent under its robot name: `<robot>/inject_fault`."""
+
+MAX_FLEET = 128
+"""Robot states a late joiner catches up on: at least the largest fleet a scenario may have."""
+
+EVENT_HISTORY = 5000
+"""Events each writer keeps for late joiners: a robot reports 4 per job attempt, so this
+covers a mission of 1000 jobs with room for redone attempts."""
+
+LATCHED_QOS = QoSProfile(
+    reliability=ReliabilityPolicy.RELIABLE,
+    durability=DurabilityPolicy.TRANSIENT_LOCAL,
+    history=HistoryPolicy.KEEP_LAST,
+    depth=1,
+)
+"""The current plan and latest status: a node that joins late gets the last one."""
+
+ROBOT_STATES_QOS = QoSProfile(
+    reliability=ReliabilityPolicy.RELIABLE,
+    durability=DurabilityPolicy.TRANSIENT_LOCAL,
+    history=HistoryPolicy.KEEP_LAST,
+    depth=MAX_FLEET,
+)
+"""Each agent is one writer keeping its latest state; a reader must hold one per robot, or a
+late joiner would get a single robot's state, and a burst (a failure followed at once by a
+recovery) could lose the failure before the reader's executor takes it."""
+
+EVENTS_QOS = QoSProfile(
+    reliability=ReliabilityPolicy.RELIABLE,
+    durability=DurabilityPolicy.TRANSIENT_LOCAL,
+    history=HistoryPolicy.KEEP_LAST,
+    depth=EVENT_HISTORY,
+)
+"""Task and mission events are facts nobody may miss: each writer keeps its history for late
+joiners (a restarted planner rebuilds a mission from the agents' histories)."""
+
+
+def _pair(vocabulary, message, prefix: str) -> tuple[dict, dict]:
+    to_msg = {word: getattr(message, f'{prefix}_{word.name}') for word in vocabulary}
+    constants = {getattr(message, name) for name in dir(message) if name.startswith(f'{prefix}_')}
+    unpaired = constants - set(to_msg.values())
+    if unpaired:
+        raise ImportError(f'{message.__name__} constants {sorted(unpaired)} have no word in '
+                          f'{vocabulary.__name__}')
+    return to_msg, {value: word for word, value in to_msg.items()}
+
+
+MODE_TO_MSG, MODE_FROM_MSG = _pair(RobotMode, RobotState, 'MODE')
+EVENT_TO_MSG, EVENT_FROM_MSG = _pair(EventKind, TaskEvent, 'KIND')
+STATE_TO_MSG, STATE_FROM_MSG = _pair(MissionState, MissionStatus, 'STATE')
+MISSION_EVENT_TO_MSG, MISSION_EVENT_FROM_MSG = _pair(MissionEventKind, MissionEvent, 'KIND')

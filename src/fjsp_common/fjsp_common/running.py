@@ -1,0 +1,107 @@
+"""What every node process of the fleet does alike: declare its parameters the ROS way, refuse
+a bad one with a one-line reason and exit code 2, and stop quietly on Ctrl-C, SIGTERM or an
+external shutdown.
+
+Parameters carry a `ParameterDescriptor` (description, range, read-only), so `ros2 param
+describe` documents them and rclpy itself refuses an out-of-range or read-only `set`, at
+start-up (`-p`, `--params-file`) and at run time alike.
+"""
+
+import re
+import signal
+from collections.abc import Callable
+
+import rclpy
+from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
+from rclpy.exceptions import InvalidParameterTypeException, InvalidParameterValueException
+from rclpy.executors import ExternalShutdownException
+from rclpy.node import Node
+
+
+class ParameterError(ValueError):
+    """A node parameter with a value the node cannot run with."""
+
+
+def declare(node: Node, name: str, default, description: str, *, low=None, high=None,
+            read_only: bool = True, constraints: str = ''):
+    """Declare parameter `name` (its type is `default`'s) and return its value.
+
+    Numbers need both `low` and `high`: rclpy checks the range on every set, and NaN or an
+    infinity is outside any finite range. `read_only` parameters are the ones the node reads
+    once; a set at run time is refused instead of being accepted and ignored.
+    """
+    descriptor = ParameterDescriptor(description=description, read_only=read_only,
+                                     additional_constraints=constraints)
+    if isinstance(default, bool) or not isinstance(default, int | float):
+        if low is not None or high is not None:
+            raise TypeError(f"parameter '{name}': a range needs a numeric default")
+    elif low is None or high is None:
+        raise TypeError(f"parameter '{name}': a number needs both ends of its range")
+    elif isinstance(default, float):
+        descriptor.floating_point_range = [FloatingPointRange(
+            from_value=float(low), to_value=float(high), step=0.0)]
+    else:
+        descriptor.integer_range = [IntegerRange(from_value=low, to_value=high, step=0)]
+    try:
+        return node.declare_parameter(name, default, descriptor).value
+    except InvalidParameterTypeException as error:
+        raise ParameterError(f"parameter '{name}' must be of type {_kind(default)}, like "
+                             f'{default!r} ({description}): {error}') from None
+    except InvalidParameterValueException as error:
+        # rclpy keeps the refused value only in its message.
+        given = re.search(r'value \((.*)\) for parameter', str(error), re.DOTALL)
+        why = (f'must be within [{_number(low)}, {_number(high)}]' if low is not None
+               else 'was refused')
+        raise ParameterError(f"parameter '{name}' {why} ({description}), got "
+                             f"{shorten(given.group(1), 80) if given else 'another value'}"
+                             ) from None
+
+
+def _kind(default) -> str:
+    return {bool: 'bool', int: 'integer', float: 'double', str: 'string'}.get(
+        type(default), type(default).__name__)
+
+
+def _number(value) -> str:
+    return f'{value:g}' if isinstance(value, float) else str(value)
+
+
+def shorten(text: str, limit: int = 200) -> str:
+    """`text` cut to `limit` characters for a log line: a forged 1 MB name must not flood it."""
+    return text if len(text) <= limit else f'{text[:limit]}... ({len(text)} characters)'
+
+
+def run_node(make_node: Callable[[], Node], logger: str, args=None,
+             spin: Callable[[Node], None] = rclpy.spin) -> int:
+    """Build the node, spin it until shutdown, clean up; the process's exit code.
+
+    SIGTERM stops the node like Ctrl-C does (rclpy would otherwise leave the process to
+    die without destroying its node), and a node still building its state when the signal
+    comes stops too.
+    """
+    rclpy.init(args=args, signal_handler_options=rclpy.signals.SignalHandlerOptions.NO)
+    previous = {sig: signal.signal(sig, _interrupt) for sig in (signal.SIGINT, signal.SIGTERM)}
+    node = None
+    code = 0
+    try:
+        node = make_node()
+        spin(node)
+    except ParameterError as error:
+        rclpy.logging.get_logger(logger).error(str(error))
+        code = 2
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+        if node is not None:
+            try:
+                node.destroy_node()
+            except (KeyboardInterrupt, ExternalShutdownException):
+                pass
+        rclpy.try_shutdown()
+    return code
+
+
+def _interrupt(signum, frame):
+    raise KeyboardInterrupt

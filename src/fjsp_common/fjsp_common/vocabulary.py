@@ -1,0 +1,70 @@
+"""The fleet's words, defined once and free of ROS so the domain core can use them too.
+
+Each enum member has a message constant of the same name (`RobotState.MODE_<NAME>`,
+`TaskEvent.KIND_<NAME>`, `MissionStatus.STATE_<NAME>`, `MissionEvent.KIND_<NAME>`);
+`fjsp_common.contract` pairs them by name, so no order has to match anywhere.
+"""
+
+from enum import StrEnum
+
+
+class RobotMode(StrEnum):
+    IDLE = 'idle'
+    TRAVELLING = 'travelling'
+    WAITING = 'waiting'
+    """At the job's location, waiting for predecessors or co-workers."""
+    WORKING = 'working'
+    HOLDING = 'holding'
+    """Keeps holding a part into its next job."""
+    FAILED = 'failed'
+    OFFLINE = 'offline'
+    """Heartbeat lost; set by observers, never by the robot itself."""
+
+    @property
+    def healthy(self) -> bool:
+        return self not in (RobotMode.FAILED, RobotMode.OFFLINE)
+
+
+class EventKind(StrEnum):
+    """What happened to a job: robots report the first four, the planner JOB_DONE."""
+
+    ARRIVED = 'arrived'
+    STARTED = 'started'
+    OPERATION_DONE = 'operation_done'
+    JOB_DONE = 'job_done'
+    ABORTED = 'aborted'
+
+
+class MissionState(StrEnum):
+    IDLE = 'idle'
+    """No mission: the planner waits for one."""
+    WAITING_FOR_ROBOTS = 'waiting for robots'
+    PLANNING = 'planning'
+    EXECUTING = 'executing'
+    REPLANNING = 'replanning'
+    BLOCKED = 'blocked'
+    COMPLETE = 'complete'
+    CANCELLED = 'cancelled'
+    FAILED = 'failed'
+
+    @property
+    def ended(self) -> bool:
+        return self in (MissionState.COMPLETE, MissionState.CANCELLED, MissionState.FAILED)
+
+
+class MissionEventKind(StrEnum):
+    """What the planner decided or noticed: the story of a mission."""
+
+    MISSION_STARTED = 'mission started'
+    PLAN_PUBLISHED = 'plan published'
+    ROBOT_FAILED = 'robot failed'
+    ROBOT_OFFLINE = 'robot offline'
+    ROBOT_BACK = 'robot back'
+    JOB_ABORTED = 'job aborted'
+    JOB_VOIDED = 'job voided'
+    BLOCKED = 'blocked'
+    WARNING = 'warning'
+    JOBS_ADDED = 'jobs added'
+    MISSION_COMPLETE = 'mission complete'
+    MISSION_CANCELLED = 'mission cancelled'
+    MISSION_FAILED = 'mission failed'
