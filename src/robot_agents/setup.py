@@ -14,10 +14,11 @@ setup(
     zip_safe=True,
     maintainer='fjsp team',
     maintainer_email='team@fjsp.invalid',
-    description='Mock Assembler / MARC / LSMS agents executing planned task sequences',
+    description='Generic mock robot agent executing planned task sequences (+ per-type aliases)',
     license='Apache-2.0',
     entry_points={
         'console_scripts': [
+            'robot_agent = robot_agents.agent_node:main',
             'assembler_agent = robot_agents.agent_node:assembler_main',
             'marc_agent = robot_agents.agent_node:marc_main',
             'lsms_agent = robot_agents.agent_node:lsms_main',

@@ -4,7 +4,8 @@ import math
 
 import pytest
 
-from robot_agents.execution import EventKind, Mode, RobotExecution, Task
+from fjsp_common.vocabulary import EventKind, RobotMode
+from robot_agents.execution import RobotExecution, Task
 
 ARRIVED, STARTED, DONE, ABORTED = (EventKind.ARRIVED, EventKind.STARTED,
                                    EventKind.OPERATION_DONE, EventKind.ABORTED)
@@ -35,25 +36,25 @@ def test_solo_sequence_travels_and_works_in_logical_time():
     r = RobotExecution('A')
     plan(r, 1, [task('J1', 0, 2), task('J2', 5, 1, leg=3)])
     assert kinds(r.step(0)) == [(ARRIVED, 'J1', 0), (STARTED, 'J1', 0)]
-    assert r.mode == Mode.WORKING and r.progress(1) == pytest.approx(0.5)
+    assert r.mode == RobotMode.WORKING and r.progress(1) == pytest.approx(0.5)
     # Stepping late (at 10) still reports the instants the work was due at.
     assert kinds(r.step(10)) == [(DONE, 'J1', 2), (ARRIVED, 'J2', 5), (STARTED, 'J2', 5),
                                  (DONE, 'J2', 6)]
-    assert r.finished and r.mode == Mode.IDLE and r.location == 'J2'
+    assert r.finished and r.mode == RobotMode.IDLE and r.location == 'J2'
 
 
 def test_job_waits_for_co_workers_and_predecessors():
     r = RobotExecution('A')
     plan(r, 1, [task('J2', 4, 1, co=['B'], preds=['J1'])], {'J1': {'B'}, 'J2': {'A', 'B'}})
     assert kinds(r.step(3)) == [(ARRIVED, 'J2', 0)]
-    assert r.mode == Mode.WAITING
+    assert r.mode == RobotMode.WAITING
     r.operation_done('B', 'J1', 3.0, 1)   # J1's only robot is done: J1 is complete at 3
     assert r.step(3.5) == []              # B has not arrived yet
     r.arrived('B', 'J2', 3.25, 1)
     assert kinds(r.step(3.5)) == [(STARTED, 'J2', 3.25)]
     assert r.step(4.2) == []
     assert kinds(r.step(4.3)) == [(DONE, 'J2', 4.25)]
-    assert r.mode == Mode.WAITING         # occupied until B's operation ends too
+    assert r.mode == RobotMode.WAITING         # occupied until B's operation ends too
     r.job_done('J2', 6.0, 1)
     r.step(6.0)
     assert r.finished
@@ -72,10 +73,10 @@ def holder():
 def test_holder_stays_holding_into_the_next_job():
     r = holder()
     r.step(2)
-    assert r.mode == Mode.HOLDING and r.current_job == 'Ja'
+    assert r.mode == RobotMode.HOLDING and r.current_job == 'Ja'
     r.operation_done('B', 'Ja', 5.0, 1)
     assert kinds(r.step(5)) == [(ARRIVED, 'Aa', 5)]   # no travel while holding
-    assert r.mode == Mode.HOLDING and r.current_job == 'Aa'
+    assert r.mode == RobotMode.HOLDING and r.current_job == 'Aa'
 
 
 def test_stale_revision_is_refused():
@@ -110,17 +111,17 @@ def test_fail_while_working_aborts_and_stops_until_recovered_and_replanned():
     assert result.accepted and "robot 'A' failed at t=2.50" in result.message
     assert kinds(result.events) == [(ABORTED, 'J1', 2.5)]
     assert result.events[0].attempt == 1 and result.events[0].reason == "robot 'A' failed"
-    assert r.mode == Mode.FAILED and r.current_job == '' and math.isnan(r.busy_until)
+    assert r.mode == RobotMode.FAILED and r.current_job == '' and math.isnan(r.busy_until)
     assert r.step(10) == []
     again = r.fail(3)
     assert not again.accepted and again.message == "fail refused: robot 'A' has already failed"
     assert not r.delay(2.0, 3).accepted
     plan(r, 2, [task('J2', 11, 1)], now=5)     # taken, but not acted on while failed
-    assert r.revision == 2 and r.step(12) == [] and r.mode == Mode.FAILED
+    assert r.revision == 2 and r.step(12) == [] and r.mode == RobotMode.FAILED
 
     result = r.recover(6)
     assert result.accepted and "recovered at t=6.00 at 'J1'" in result.message
-    assert r.step(6) == [] and r.mode == Mode.IDLE and r.location == 'J1'   # tasks dropped
+    assert r.step(6) == [] and r.mode == RobotMode.IDLE and r.location == 'J1'   # tasks dropped
     assert r.recover(7).message == "recover refused: robot 'A' has not failed"
     plan(r, 3, [task('J1', 7, 4), task('J2', 11, 1)], now=7)  # J1 is redone
     assert attempts(r.step(7)) == [(ARRIVED, 'J1', 2), (STARTED, 'J1', 2)]
@@ -132,21 +133,21 @@ def test_fail_mid_leg_freezes_it_and_recovery_ends_the_leg():
     r = RobotExecution('A')
     plan(r, 1, [task('J0', 0, 1), task('J1', 5, 1, leg=4)])
     r.step(3)                              # left J0 at 1, due at J1 at 5
-    assert r.mode == Mode.TRAVELLING and r.progress(3) == pytest.approx(0.5)
+    assert r.mode == RobotMode.TRAVELLING and r.progress(3) == pytest.approx(0.5)
     result = r.fail(3)
     assert result.accepted and result.events == []
     assert "from 'J0' to 'J1' (50% done)" in result.message
-    assert (r.mode, r.location, r.destination) == (Mode.FAILED, 'J0', 'J1')
+    assert (r.mode, r.location, r.destination) == (RobotMode.FAILED, 'J0', 'J1')
     assert r.progress(9) == pytest.approx(0.5)
     assert r.step(100) == []
 
     r.recover(10)                          # 2 units of the leg are left
     assert (r.mode, r.current_job, r.location, r.destination) == (
-        Mode.TRAVELLING, '', 'J0', 'J1')
+        RobotMode.TRAVELLING, '', 'J0', 'J1')
     assert r.busy_until == pytest.approx(12) and r.progress(11) == pytest.approx(0.75)
     assert r.step(11.9) == []
     assert r.step(12.1) == []              # a leg of no task reports no arrival
-    assert (r.mode, r.location, r.destination) == (Mode.IDLE, 'J1', '')
+    assert (r.mode, r.location, r.destination) == (RobotMode.IDLE, 'J1', '')
     plan(r, 2, [task('J1', 13, 1)], now=12.5)
     # Its first attempt at J1 began with the leg, so this arrival is its second.
     assert attempts(r.step(12.5)) == [(ARRIVED, 'J1', 2), (STARTED, 'J1', 2)]
@@ -157,13 +158,13 @@ def test_fail_while_holding_releases_the_hold():
     r = holder()
     r.operation_done('B', 'Ja', 5.0, 1)
     r.step(6)
-    assert r.mode == Mode.HOLDING and r.current_job == 'Aa'
+    assert r.mode == RobotMode.HOLDING and r.current_job == 'Aa'
     result = r.fail(6)
-    assert result.accepted and result.events == [] and r.mode == Mode.FAILED
+    assert result.accepted and result.events == [] and r.mode == RobotMode.FAILED
     # The planner voids Ja (its holder failed) and gives A nothing while it is down.
     plan(r, 2, [], {'Ja': {'B'}, 'Aa': {'B'}}, now=6.5)
     r.recover(8)
-    assert r.mode == Mode.IDLE and r.location == 'Aa'
+    assert r.mode == RobotMode.IDLE and r.location == 'Aa'
     # Ja is redone under revision 3: no longer held, so A travels there.
     plan(r, 3, [task('Ja', 11, 1, leg=3)], now=8)
     assert kinds(r.step(11.1)) == [(ARRIVED, 'Ja', 11), (STARTED, 'Ja', 11)]
@@ -192,7 +193,7 @@ def test_delay_of_the_next_operation():
     r = RobotExecution('A')
     plan(r, 1, [task('J0', 0, 1), task('J1', 3, 4, leg=2), task('J2', 7, 2)])
     r.step(2)
-    assert r.mode == Mode.TRAVELLING       # left J0 at 1, due at J1 at 3
+    assert r.mode == RobotMode.TRAVELLING       # left J0 at 1, due at J1 at 3
     result = r.delay(3.0, 2)
     assert result.accepted and 'next operation it begins takes 3 times' in result.message
     assert r.busy_until == pytest.approx(3)   # the leg is not slowed
@@ -239,7 +240,7 @@ def test_restarted_job_drops_stale_facts_and_ignores_late_ones():
     # Revision 2 restarts J2 (not continued); J1 is done and no longer in the plan.
     plan(r, 2, [task('J2', 4, 2, co=['B'], preds=['J1'])], {'J2': {'A', 'B'}}, now=3)
     assert attempts(r.step(3)) == [(ARRIVED, 'J2', 2)]
-    assert r.mode == Mode.WAITING          # B's arrival of revision 1 no longer counts
+    assert r.mode == RobotMode.WAITING          # B's arrival of revision 1 no longer counts
     assert not r.arrived('B', 'J2', 1.0, 1)   # a late report of revision 1 is ignored
     assert r.step(5) == []
     assert r.arrived('B', 'J2', 4.0, 2)
@@ -261,7 +262,7 @@ def test_continued_job_goes_on_and_restarted_one_is_abandoned():
     plan(r, 1, [task('J1', 0, 4), task('J2', 4, 1)])
     r.step(1)
     plan(r, 2, [task('J1', 0, 4), task('J3', 4, 1)], now=1, continued={'J1'})
-    assert r.mode == Mode.WORKING and r.current_job == 'J1'
+    assert r.mode == RobotMode.WORKING and r.current_job == 'J1'
     assert r.busy_until == pytest.approx(4)
     # Revision 3 restarts J1: A leaves it without an event, free now, and comes back to it.
     plan(r, 3, [task('J1', 2, 4), task('J3', 6, 1)], now=2)
@@ -293,7 +294,7 @@ def test_robot_finishes_its_leg_before_following_the_new_sequence():
     r.step(2)                              # on its way to J2, due at 5
     plan(r, 2, [task('J3', 8, 1, leg=3)], now=2)
     assert (r.mode, r.current_job, r.location, r.destination) == (
-        Mode.TRAVELLING, '', 'J1', 'J2')
+        RobotMode.TRAVELLING, '', 'J1', 'J2')
     assert r.busy_until == pytest.approx(5)
     assert kinds(r.step(10)) == [(ARRIVED, 'J3', 8), (STARTED, 'J3', 8), (DONE, 'J3', 9)]
 
@@ -305,7 +306,7 @@ def test_own_operation_done_and_continued_keeps_waiting_for_the_job_end():
     r.step(2)
     plan(r, 2, [task('J1', 0, 1, end=3, co=['B'])], {'J1': {'A', 'B'}}, now=2,
          continued={'J1'})
-    assert r.mode == Mode.WAITING and r.current_job == 'J1'
+    assert r.mode == RobotMode.WAITING and r.current_job == 'J1'
     r.operation_done('B', 'J1', 3.0, 1)
     r.step(3)
     assert r.finished
@@ -320,7 +321,7 @@ def test_holder_keeps_holding_through_a_restart_of_the_held_job():
                 task('Aa', 8, 5, co=['C'], preds=['Ja'], leg=2)],
          {'Ja': {'A'}, 'Aa': {'A', 'C'}}, now=7, continued={'Ja'})
     assert attempts(r.step(7)) == [(ARRIVED, 'Aa', 2)]   # no travel: still holding
-    assert r.mode == Mode.HOLDING
+    assert r.mode == RobotMode.HOLDING
     r.arrived('C', 'Aa', 8.0, 2)
     assert kinds(r.step(8)) == [(STARTED, 'Aa', 8)]
 
@@ -330,8 +331,8 @@ def test_running_held_job_after_a_done_jig_job_is_continued():
     r.operation_done('B', 'Ja', 5.0, 1)
     r.arrived('B', 'Aa', 5.0, 1)
     r.step(6)
-    assert r.mode == Mode.WORKING and r.current_job == 'Aa'
+    assert r.mode == RobotMode.WORKING and r.current_job == 'Aa'
     plan(r, 2, [task('Ja', 0, 1, end=5, held=True), task('Aa', 5, 5, co=['B'], preds=['Ja'])],
          {'Ja': {'A'}, 'Aa': {'A', 'B'}}, now=6, continued={'Ja', 'Aa'})
-    assert r.mode == Mode.WORKING and r.current_job == 'Aa'
+    assert r.mode == RobotMode.WORKING and r.current_job == 'Aa'
     assert kinds(r.step(10.1)) == [(DONE, 'Aa', 10)]

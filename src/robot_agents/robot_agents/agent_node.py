@@ -1,68 +1,83 @@
-"""A mock robot: follows its task sequence of the latest plan in simulated time.
+"""A mock robot of any type: follows its task sequence of the latest plan in simulated time.
 
-One process per robot (`robot_name` parameter); the three executables differ only in the robot
-type they accept, so a plan that gives MARC1 to an assembler_agent is refused, not executed.
-Faults are injected through its `<robot_name>/inject_fault` service (`fjsp_planner.faults`).
+One process per robot (`robot_name` parameter); its node is named `agent_<robot>`, so a fleet
+never has two nodes of the same name. Its type comes from the plan, unless the `robot_type`
+parameter pins it (the `assembler_agent`, `marc_agent` and `lsms_agent` executables pin the
+paper's types): a plan that makes a pinned robot another type is refused, and the refusal is
+reported in the robot's state for the planner and any monitor to see, never executed.
+
+Plans are followed per mission: revisions count within a mission, and a plan of a newer
+mission (a later `mission_start`) starts afresh from where the robot is. Faults are injected
+through `<robot_name>/inject_fault` (`fjsp_planner.faults`).
 """
 
 import sys
+import time
+from collections import deque
 
 from rclpy.exceptions import InvalidServiceNameException
 from rclpy.node import Node
 from rclpy.time import Time as RosTime
 
-from fjsp_msgs.msg import Plan, RobotState, TaskEvent
-from fjsp_msgs.srv import InjectFault
-from fjsp_planner.nodes.interfaces import (
+from fjsp_common.contract import (
+    EVENT_FROM_MSG,
+    EVENT_HISTORY,
+    EVENT_TO_MSG,
     EVENTS_QOS,
     INJECT_FAULT_SERVICE,
     LATCHED_QOS,
+    MODE_TO_MSG,
     PLAN_TOPIC,
     ROBOT_STATES_TOPIC,
     TASK_EVENTS_TOPIC,
 )
-from fjsp_planner.nodes.running import ParameterError, declared, run_node
-from robot_agents.execution import EventKind, FaultResult, Mode, RobotExecution, Task
+from fjsp_common.running import ParameterError, declare, run_node, shorten
+from fjsp_common.vocabulary import EventKind
+from fjsp_msgs.msg import Plan, RobotState, TaskEvent
+from fjsp_msgs.srv import InjectFault
+from robot_agents.execution import FaultResult, RobotExecution, Task
 
-MODE_TO_MSG = {
-    Mode.IDLE: RobotState.MODE_IDLE,
-    Mode.TRAVELLING: RobotState.MODE_TRAVELLING,
-    Mode.WAITING: RobotState.MODE_WAITING,
-    Mode.WORKING: RobotState.MODE_WORKING,
-    Mode.HOLDING: RobotState.MODE_HOLDING,
-    Mode.FAILED: RobotState.MODE_FAILED,
-}
-KIND_TO_MSG = {
-    EventKind.ARRIVED: TaskEvent.KIND_ARRIVED,
-    EventKind.STARTED: TaskEvent.KIND_STARTED,
-    EventKind.OPERATION_DONE: TaskEvent.KIND_OPERATION_DONE,
-    EventKind.ABORTED: TaskEvent.KIND_ABORTED,
-}
+NAME_LOOKUP_NODE = 'robot_agent'
+"""The short-lived node that reads `robot_name` before the agent's own node can be named."""
 
 
 class RobotAgent(Node):
-    def __init__(self, robot_type: str):
-        super().__init__(f'{robot_type.lower()}_agent')
-        self.robot_type = robot_type
-        self.robot = declared(self, 'robot_name', '')
-        self.time_scale = declared(self, 'time_scale', 0.0)
-        tick_period = declared(self, 'tick_period', 0.01)
-        heartbeat_period = declared(self, 'heartbeat_period', 0.2)
-        if not self.robot:
-            raise ParameterError("parameter 'robot_name' is required "
-                                 '(e.g. --ros-args -p robot_name:=MARC1)')
-        if not self.time_scale >= 0:
-            raise ParameterError(f"parameter 'time_scale' must be >= 0 (0: the plan's), "
-                                 f'got {self.time_scale}')
-        for name, value in (('tick_period', tick_period),
-                            ('heartbeat_period', heartbeat_period)):
-            if not value > 0:
-                raise ParameterError(f"parameter '{name}' must be > 0 seconds, got {value}")
+    def __init__(self, robot: str, pinned_type: str = ''):
+        super().__init__(agent_node_name(robot))
+        self.robot = declare(self, 'robot_name', robot,
+                             'name of the robot this agent plays, as the scenario lists it')
+        self.pinned_type = declare(
+            self, 'robot_type', pinned_type,
+            'robot type this agent must play; empty: whatever type the plan gives it') \
+            or pinned_type
+        self.time_scale = declare(
+            self, 'time_scale', 0.0, "wall seconds per schedule unit; 0: the plan's",
+            low=0.0, high=1000.0)
+        tick_period = declare(self, 'tick_period', 0.01,
+                              'seconds between steps of the simulated execution',
+                              low=0.001, high=1.0)
+        heartbeat_period = declare(self, 'heartbeat_period', 0.2,
+                                   'seconds between robot states published as heartbeat',
+                                   low=0.01, high=10.0)
+        if pinned_type and self.pinned_type != pinned_type:
+            raise ParameterError(f"parameter 'robot_type': this executable plays a "
+                                 f"'{pinned_type}', got '{self.pinned_type}' (use robot_agent "
+                                 'for other types)')
 
+        self.incarnation = time.time_ns()
+        """Tells this process's reports from those of an earlier agent of the same robot."""
+        self.event_count = 0
+        self.failures = 0
         self.execution = RobotExecution(self.robot)
+        self.mission_id = ''
         self.mission_start: RosTime | None = None
         self.scale = self.time_scale
+        self.robot_type = self.pinned_type
+        self.refusal = ''
+        """Why the latest plan received is not followed ('' when it is)."""
         self.last_state = None
+        self.early_events: deque[TaskEvent] = deque(maxlen=EVENT_HISTORY)
+        """Reports of a mission this robot does not follow (yet): its plan may come later."""
 
         self.state_pub = self.create_publisher(RobotState, ROBOT_STATES_TOPIC, LATCHED_QOS)
         self.event_pub = self.create_publisher(TaskEvent, TASK_EVENTS_TOPIC, EVENTS_QOS)
@@ -77,7 +92,8 @@ class RobotAgent(Node):
         self.create_timer(tick_period, self.tick)
         self.create_timer(heartbeat_period, self.publish_state)
         self.publish_state()
-        self.get_logger().info(f"robot '{self.robot}' ({robot_type}) ready, waiting for a plan")
+        kind = f"a '{self.pinned_type}'" if self.pinned_type else 'any type'
+        self.get_logger().info(f"robot '{self.robot}' ({kind}) ready, waiting for a plan")
 
     def now_units(self) -> float | None:
         """Schedule time since the mission start, or None before the first plan."""
@@ -86,32 +102,40 @@ class RobotAgent(Node):
         elapsed = (self.get_clock().now() - self.mission_start).nanoseconds * 1e-9
         return elapsed / self.scale
 
+    # --- plans -------------------------------------------------------------------------
+
     def on_plan(self, msg: Plan) -> None:
         log = self.get_logger()
-        if msg.revision <= self.execution.revision:
+        mission = shorten(msg.mission_id, 80)
+        new_mission = msg.mission_id != self.mission_id
+        if new_mission and self.mission_start is not None \
+                and RosTime.from_msg(msg.mission_start) <= self.mission_start:
+            log.warning(f"ignoring plan of mission '{mission}': it started no later than "
+                        f"mission '{self.mission_id}', which this robot follows")
+            return
+        if not new_mission and msg.revision <= self.execution.revision:
             if msg.revision < self.execution.revision:
                 log.warning(f'ignoring stale plan revision {msg.revision}: following '
                             f'revision {self.execution.revision}')
             return
-        mine = [r for r in msg.robots if r.robot == self.robot]
-        if not mine:
-            log.warning(f"plan revision {msg.revision} has no robot '{self.robot}'; "
-                        'staying idle')
+        refusal = self.refusal_of(msg)
+        if refusal:
+            if refusal != self.refusal:
+                log.error(refusal)
+            self.refusal = refusal
+            self.publish_state()
             return
-        if mine[0].robot_type != self.robot_type:
-            log.error(f"plan revision {msg.revision} makes '{self.robot}' a "
-                      f"'{mine[0].robot_type}' but this agent is a '{self.robot_type}'; "
-                      'ignoring the plan')
+        self.refusal = ''
+        if new_mission:
+            self.begin_mission(msg)
+        if msg.cancelled:
+            self.cancel(msg)
             return
-        if not msg.time_scale > 0:
-            log.error(f'plan revision {msg.revision} has time_scale {msg.time_scale}; '
-                      'ignoring the plan')
-            return
+        mine = next(r for r in msg.robots if r.robot == self.robot)
+        self.robot_type = mine.robot_type
         if self.time_scale and self.time_scale != msg.time_scale:
             log.warning(f'running at time_scale {self.time_scale} s/unit while the plan '
                         f'assumes {msg.time_scale}: this robot runs off the planned pace')
-        self.scale = self.time_scale or msg.time_scale
-        self.mission_start = RosTime.from_msg(msg.mission_start)
         job_robots, continued = {}, set()
         for robot_plan in msg.robots:
             for t in robot_plan.tasks:
@@ -123,36 +147,81 @@ class RobotAgent(Node):
                       operation_end=t.operation_end, end=t.end,
                       co_workers=tuple(t.co_workers), predecessors=tuple(t.predecessors),
                       held_into_next=t.held_into_next)
-                 for t in mine[0].tasks]
+                 for t in mine.tasks]
         now = self.now_units()
         if now >= 0:
             # What was due before the new revision happened under the old one.
             self.publish_events(self.execution.step(now))
         self.execution.set_plan(msg.revision, tasks, job_robots, max(now, 0.0),
                                 continued=continued)
-        log.info(f'following plan revision {msg.revision}: '
+        log.info(f"following plan revision {msg.revision} of mission '{mission}': "
                  + (' -> '.join(t.job for t in tasks) or 'no task'))
         self.publish_state()  # a new revision is a transition, even before the mission start
         self.tick()
 
+    def refusal_of(self, msg: Plan) -> str:
+        """Why this agent cannot follow `msg`, or '' if it can."""
+        where = f"plan revision {msg.revision} of mission '{shorten(msg.mission_id, 80)}'"
+        if not msg.time_scale > 0 or msg.time_scale == float('inf'):
+            return f'{where} has time_scale {msg.time_scale}; ignoring the plan'
+        mine = [r for r in msg.robots if r.robot == self.robot]
+        if not mine:
+            if msg.cancelled:
+                return ''
+            return (f"{where} has no robot '{self.robot}': this agent's robot is not in "
+                    f"scenario '{shorten(msg.scenario_id, 80)}'")
+        if self.pinned_type and mine[0].robot_type != self.pinned_type:
+            return (f"{where} makes '{self.robot}' a '{shorten(mine[0].robot_type, 80)}' but "
+                    f"this agent plays a '{self.pinned_type}'; refusing the plan")
+        return ''
+
+    def begin_mission(self, msg: Plan) -> None:
+        self.execution.start_mission()
+        self.mission_id = msg.mission_id
+        self.mission_start = RosTime.from_msg(msg.mission_start)
+        self.scale = self.time_scale or msg.time_scale
+        self.last_state = None
+        early = [e for e in self.early_events if e.mission_id == msg.mission_id]
+        self.early_events.clear()
+        for event in early:
+            self.on_event(event)
+
+    def cancel(self, msg: Plan) -> None:
+        now = max(self.now_units(), 0.0)
+        self.publish_events(self.execution.cancel(now, 'mission cancelled'))
+        # The cancelling revision is followed like any other, so older ones stay stale.
+        self.execution.set_plan(msg.revision, (), {}, now, continued=())
+        self.get_logger().warning(f"mission '{shorten(msg.mission_id, 80)}' cancelled: "
+                                  'tasks dropped')
+        self.publish_state()
+
+    # --- what the others report --------------------------------------------------------
+
     def on_event(self, msg: TaskEvent) -> None:
-        if msg.robot == self.robot and msg.kind != TaskEvent.KIND_JOB_DONE:
+        if msg.mission_id != self.mission_id:
+            # The plan of a mission may come after the first reports of the others.
+            self.early_events.append(msg)
+            return
+        kind = EVENT_FROM_MSG.get(msg.kind)
+        if kind is None or (msg.robot == self.robot and kind != EventKind.JOB_DONE):
             return
         execution, revision = self.execution, msg.plan_revision
-        if msg.kind == TaskEvent.KIND_ARRIVED:
+        if kind == EventKind.ARRIVED:
             used = execution.arrived(msg.robot, msg.job, msg.time, revision)
-        elif msg.kind == TaskEvent.KIND_OPERATION_DONE:
+        elif kind == EventKind.OPERATION_DONE:
             used = execution.operation_done(msg.robot, msg.job, msg.time, revision)
-        elif msg.kind == TaskEvent.KIND_JOB_DONE:
+        elif kind == EventKind.JOB_DONE:
             used = execution.job_done(msg.job, msg.time, revision)
-        elif msg.kind == TaskEvent.KIND_ABORTED:
+        elif kind == EventKind.ABORTED:
             used = execution.aborted(msg.job, revision)
         else:
             return
         if not used:
-            self.get_logger().debug(f"ignoring event '{msg.event_id}' of revision {revision}: "
-                                    f"job '{msg.job}' was restarted since")
+            self.get_logger().debug(f"ignoring event '{shorten(msg.event_id)}' of revision "
+                                    f"{revision}: job '{shorten(msg.job)}' was restarted since")
         self.tick()
+
+    # --- faults ------------------------------------------------------------------------
 
     def on_fault(self, request, response):
         now = self.now_units()
@@ -170,6 +239,8 @@ class RobotAgent(Node):
                                         f'{request.fault} (FAIL=0, RECOVER=1, DELAY=2)')
         self.publish_events(result.events)
         if result.accepted:
+            if request.fault == InjectFault.Request.FAULT_FAIL:
+                self.failures += 1
             self.get_logger().warning(f'fault injected: {result.message}')
             self.publish_state()
         else:
@@ -177,43 +248,80 @@ class RobotAgent(Node):
         response.success, response.message = result.accepted, result.message
         return response
 
+    # --- stepping and reporting --------------------------------------------------------
+
     def tick(self) -> None:
         now = self.now_units()
         if now is None or now < 0:
             return
         self.publish_events(self.execution.step(now))
-        state = (self.execution.mode, self.execution.current_job, self.execution.location,
-                 self.execution.revision)
-        if state != self.last_state:
+        if self.state_key() != self.last_state:
             self.publish_state()
+
+    def state_key(self):
+        execution = self.execution
+        return (execution.mode, execution.current_job, execution.location,
+                execution.revision, self.refusal, self.mission_id)
 
     def publish_events(self, events) -> None:
         for e in events:
-            kind = e.kind.value
+            self.event_count += 1
             self.event_pub.publish(TaskEvent(
                 stamp=self.get_clock().now().to_msg(),
-                event_id=f'{self.robot}/{e.job}/{kind}/{e.attempt}',
-                kind=KIND_TO_MSG[e.kind], robot=self.robot, job=e.job,
-                plan_revision=self.execution.revision, time=e.time, reason=e.reason))
-            self.get_logger().info(f'{kind} {e.job} at t={e.time:.2f}'
-                                   + (f' ({e.reason})' if e.reason else ''))
+                event_id=f'{self.robot}/{self.incarnation}/{self.event_count}',
+                mission_id=self.mission_id, kind=EVENT_TO_MSG[e.kind], robot=self.robot,
+                job=e.job, plan_revision=self.execution.revision, time=e.time,
+                reason=e.reason))
+            self.get_logger().info(f'{e.kind.value} {e.job} at t={e.time:.2f} (attempt '
+                                   f'{e.attempt})' + (f' ({e.reason})' if e.reason else ''))
 
     def publish_state(self) -> None:
         now = self.now_units()
         execution = self.execution
-        self.last_state = (execution.mode, execution.current_job, execution.location,
-                           execution.revision)
+        self.last_state = self.state_key()
         self.state_pub.publish(RobotState(
             stamp=self.get_clock().now().to_msg(), robot=self.robot,
-            robot_type=self.robot_type, mode=MODE_TO_MSG[execution.mode],
-            plan_revision=execution.revision, current_job=execution.current_job,
-            location=execution.location, destination=execution.destination,
+            robot_type=self.robot_type, incarnation=self.incarnation,
+            mission_id=self.mission_id, mode=MODE_TO_MSG[execution.mode],
+            plan_revision=execution.revision, refusal=self.refusal, failures=self.failures,
+            current_job=execution.current_job, location=execution.location,
+            destination=execution.destination,
             progress=execution.progress(now) if now is not None else 0.0,
             busy_until=execution.busy_until))
 
 
-def run(robot_type: str, args=None) -> int:
-    return run_node(lambda: RobotAgent(robot_type), f'{robot_type.lower()}_agent', args)
+def agent_node_name(robot: str) -> str:
+    return f'agent_{robot}'
+
+
+def robot_name_from_parameters() -> str:
+    """The `robot_name` parameter as given (-p, --params-file), read before the agent's node
+    exists, because the node is named after it."""
+    probe = Node(NAME_LOOKUP_NODE, start_parameter_services=False,
+                 enable_rosout=False)
+    try:
+        robot = declare(probe, 'robot_name', '',
+                        'name of the robot this agent plays, as the scenario lists it')
+    finally:
+        probe.destroy_node()
+    if not robot:
+        raise ParameterError("parameter 'robot_name' is required "
+                             '(e.g. --ros-args -p robot_name:=MARC1)')
+    if not robot.replace('_', 'a').isalnum() or not robot[0].isalpha() \
+            or not robot.isascii():
+        raise ParameterError("parameter 'robot_name' must be usable in a ROS name (ASCII "
+                             f'letters, digits, underscores, starting with a letter), got '
+                             f'{shorten(robot, 80)!r}')
+    return robot
+
+
+def run(pinned_type: str = '', args=None) -> int:
+    return run_node(lambda: RobotAgent(robot_name_from_parameters(), pinned_type),
+                    'robot_agent', args)
+
+
+def main(args=None):
+    sys.exit(run('', args))
 
 
 def assembler_main(args=None):
@@ -226,4 +334,3 @@ def marc_main(args=None):
 
 def lsms_main(args=None):
     sys.exit(run('LSMS', args))
-

@@ -17,6 +17,8 @@ import math
 from dataclasses import dataclass, field
 from enum import StrEnum
 
+from fjsp_common.vocabulary import EventKind, RobotMode
+
 # Reported ends are rounded up onto this grid (schedule units) so that float rounding never
 # makes an operation or a leg look shorter than it is when checked in exact arithmetic.
 GRID = 1e-6
@@ -25,22 +27,6 @@ GRID = 1e-6
 def later(t: float) -> float:
     """The first grid point at least half a grid step after t."""
     return math.ceil(t / GRID + 0.5) * GRID
-
-
-class Mode(StrEnum):
-    IDLE = 'idle'
-    TRAVELLING = 'travelling'
-    WAITING = 'waiting'
-    WORKING = 'working'
-    HOLDING = 'holding'
-    FAILED = 'failed'
-
-
-class EventKind(StrEnum):
-    ARRIVED = 'arrived'
-    STARTED = 'started'
-    OPERATION_DONE = 'operation_done'
-    ABORTED = 'aborted'
 
 
 @dataclass(frozen=True)
@@ -157,18 +143,18 @@ class RobotExecution:
         return task.job if task else ''
 
     @property
-    def mode(self) -> Mode:
+    def mode(self) -> RobotMode:
         if self._phase == _Phase.FAILED:
-            return Mode.FAILED
+            return RobotMode.FAILED
         if self._phase in (_Phase.TRAVEL, _Phase.TRANSIT):
-            return Mode.TRAVELLING
+            return RobotMode.TRAVELLING
         if self._phase == _Phase.WORK:
-            return Mode.WORKING
+            return RobotMode.WORKING
         if self._phase == _Phase.FINISH:
-            return Mode.HOLDING if self.task.held_into_next else Mode.WAITING
+            return RobotMode.HOLDING if self.task.held_into_next else RobotMode.WAITING
         if self._phase == _Phase.WAIT:
-            return Mode.HOLDING if self._holding else Mode.WAITING
-        return Mode.IDLE
+            return RobotMode.HOLDING if self._holding else RobotMode.WAITING
+        return RobotMode.IDLE
 
     @property
     def busy_until(self) -> float:
@@ -365,6 +351,37 @@ class RobotExecution:
     def _work_left(self) -> bool:
         after = self._index + 1 if self._phase == _Phase.FINISH else self._index
         return any(not self._finished(t.job) for t in self.tasks[after:])
+
+    # --- missions --------------------------------------------------------------------
+
+    def cancel(self, now: float, reason: str) -> list[Event]:
+        """The mission was cancelled at `now`: every task is dropped and a hold released; a
+        job the robot is at (waiting, working or finishing) is reported ABORTED with `reason`.
+        A leg under way is finished first, as a robot cannot vanish mid-leg."""
+        events = self.step(now)
+        task = self.task
+        if task is not None and self._phase in (_Phase.WAIT, _Phase.WORK, _Phase.FINISH):
+            events.append(Event(EventKind.ABORTED, task.job, now, self._attempts[task.job],
+                                reason))
+        self.tasks, self._index, self._holding = (), 0, ''
+        if self._phase in (_Phase.TRAVEL, _Phase.TRANSIT):
+            self._phase = _Phase.TRANSIT
+        elif self._phase != _Phase.FAILED:
+            self._phase, self.destination, self._free_at = _Phase.DONE, '', now
+        return events
+
+    def start_mission(self) -> None:
+        """Forget the previous mission (its plans, facts and clock), keeping where the robot
+        is and whether it has failed. A leg still under way counts as arrived, and a robot
+        failed mid-leg stays where it stopped: the new mission plans from there."""
+        failed = self._phase == _Phase.FAILED
+        here = self.location
+        if self._phase in (_Phase.TRAVEL, _Phase.TRANSIT) and self.destination:
+            here = self.destination
+        self.__init__(self.robot)
+        self.location = here
+        if failed:
+            self._phase, self._failed_at = _Phase.FAILED, 0.0
 
     # --- stepping --------------------------------------------------------------------
 
