@@ -24,8 +24,7 @@ import rclpy
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.time import Time
 
-from fjsp_msgs.msg import MissionStatus, Plan, RobotState, TaskEvent
-from fjsp_planner.nodes.interfaces import (
+from fjsp_common.contract import (
     EVENTS_QOS,
     LATCHED_QOS,
     MISSION_STATUS_TOPIC,
@@ -33,6 +32,7 @@ from fjsp_planner.nodes.interfaces import (
     ROBOT_STATES_TOPIC,
     TASK_EVENTS_TOPIC,
 )
+from fjsp_msgs.msg import MissionStatus, Plan, RobotState, TaskEvent
 
 ROBOTS = (('Assembler', 'assembler_agent'), ('LSMS', 'lsms_agent'),
           ('MARC1', 'marc_agent'), ('MARC2', 'marc_agent'))

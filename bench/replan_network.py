@@ -25,9 +25,9 @@ from pathlib import Path
 
 from node_network import ROBOTS, Nodes, Recorder
 
+from fjsp_common.contract import INJECT_FAULT_SERVICE
 from fjsp_msgs.msg import MissionStatus
 from fjsp_msgs.srv import InjectFault
-from fjsp_planner.nodes.interfaces import INJECT_FAULT_SERVICE
 
 TIME_SCALE = {1: 0.25, 2: 0.1, 5: 0.05}
 """Wall seconds per schedule unit, so that each mission lasts some 8 to 16 s."""

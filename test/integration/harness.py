@@ -27,9 +27,7 @@ if shutil.which('ros2') is None or 'AMENT_PREFIX_PATH' not in os.environ:
 import rclpy  # noqa: E402  (after the environment check, for a clear message)
 from rclpy.executors import SingleThreadedExecutor  # noqa: E402
 
-from fjsp_msgs.msg import JobStates, MissionStatus, Plan, RobotState, TaskEvent  # noqa: E402
-from fjsp_planner.core.schedule import JobAssignment, Schedule  # noqa: E402
-from fjsp_planner.nodes.interfaces import (  # noqa: E402
+from fjsp_common.contract import (  # noqa: E402
     EVENTS_QOS,
     JOB_STATES_TOPIC,
     LATCHED_QOS,
@@ -38,6 +36,8 @@ from fjsp_planner.nodes.interfaces import (  # noqa: E402
     ROBOT_STATES_TOPIC,
     TASK_EVENTS_TOPIC,
 )
+from fjsp_msgs.msg import JobStates, MissionStatus, Plan, RobotState, TaskEvent  # noqa: E402
+from fjsp_planner.core.schedule import JobAssignment, Schedule  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[2]
 SCENARIO = REPO / 'config' / 'scenarios' / 'solar_panel.yaml'

@@ -13,12 +13,12 @@ from harness import SCENARIO
     (['run', 'fjsp_planner', 'planner_node', '--ros-args', '-p', f'scenario:={SCENARIO}',
       '-p', 'time_scale:=-1.0'], 2, "parameter 'time_scale' must be"),  # negative scale
     (['run', 'fjsp_planner', 'planner_node', '--ros-args', '-p', 'workers:=two'],
-     2, "parameter 'workers' must be a int"),  # wrong parameter type
+     2, "parameter 'workers' must be of type integer"),  # wrong parameter type
     (['run', 'robot_agents', 'marc_agent'], 2, "parameter 'robot_name' is required"),
     (['run', 'robot_agents', 'lsms_agent', '--ros-args', '-p', 'robot_name:=LSMS',
-      '-p', 'tick_period:=0.0'], 2, "parameter 'tick_period' must be > 0"),
+      '-p', 'tick_period:=0.0'], 2, "parameter 'tick_period' must be within [0.001, 1]"),
     (['run', 'fjsp_planner', 'monitor_node', '--ros-args', '-p', 'refresh_period:=0.0'],
-     2, "parameter 'refresh_period' must be > 0"),
+     2, "parameter 'refresh_period' must be within [0.05, 60]"),
     (['run', 'no_such_package', 'x'], 1, "Package 'no_such_package' not found"),
     (['run', 'robot_agents', 'no_such_agent'], 1, 'No executable found'),
     (['topic', 'list'], 2, 'not provided by this front end'),

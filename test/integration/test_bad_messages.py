@@ -5,14 +5,14 @@ import time
 
 from harness import ROBOTS
 
-from fjsp_msgs.msg import Plan, RobotState, TaskEvent
-from fjsp_planner.nodes.interfaces import (
+from fjsp_common.contract import (
     EVENTS_QOS,
     LATCHED_QOS,
     PLAN_TOPIC,
     ROBOT_STATES_TOPIC,
     TASK_EVENTS_TOPIC,
 )
+from fjsp_msgs.msg import Plan, RobotState, TaskEvent
 
 
 def test_bad_messages_are_ignored_and_counted(launcher, observer):
@@ -40,10 +40,13 @@ def test_bad_messages_are_ignored_and_counted(launcher, observer):
     with observer.lock:
         original = next(e for e in observer.events if e.kind == TaskEvent.KIND_STARTED)
     events.publish(original)
-    events.publish(TaskEvent(event_id='R2D2/M1/started/1', kind=TaskEvent.KIND_STARTED,
-                             robot='R2D2', job='M1', plan_revision=1, time=1.0))
-    events.publish(TaskEvent(event_id='MARC1/Zz/started/1', kind=TaskEvent.KIND_STARTED,
-                             robot='MARC1', job='Zz', plan_revision=1, time=1.0))
+    mission = original.mission_id
+    events.publish(TaskEvent(event_id='R2D2/M1/started/1', mission_id=mission,
+                             kind=TaskEvent.KIND_STARTED, robot='R2D2', job='M1',
+                             plan_revision=1, time=1.0))
+    events.publish(TaskEvent(event_id='MARC1/Zz/started/1', mission_id=mission,
+                             kind=TaskEvent.KIND_STARTED, robot='MARC1', job='Zz',
+                             plan_revision=1, time=1.0))
     # Robot states are heartbeats: publish a few, as a robot would; counted once per robot.
     for _ in range(10):
         states.publish(RobotState(robot='R2D2', mode=RobotState.MODE_IDLE))

@@ -98,8 +98,8 @@ def _own_node(args):
 def _call(node, robot, fault, factor, timeout) -> str:
     from rclpy.exceptions import InvalidServiceNameException
 
+    from fjsp_common.contract import INJECT_FAULT_SERVICE
     from fjsp_msgs.srv import InjectFault
-    from fjsp_planner.nodes.interfaces import INJECT_FAULT_SERVICE
 
     try:
         client = node.create_client(InjectFault, f'{robot}/{INJECT_FAULT_SERVICE}')

@@ -16,16 +16,10 @@ from dataclasses import dataclass, field
 from enum import StrEnum
 from fractions import Fraction
 
+from fjsp_common.vocabulary import EventKind, RobotMode
 from fjsp_planner.core.problem import Problem
 from fjsp_planner.core.replan import ExecutionState, RobotState
 from fjsp_planner.core.schedule import JobAssignment, Schedule
-
-
-class EventKind(StrEnum):
-    ARRIVED = 'arrived'
-    STARTED = 'started'
-    OPERATION_DONE = 'operation_done'
-    ABORTED = 'aborted'
 
 
 class Ignored(StrEnum):
@@ -34,13 +28,6 @@ class Ignored(StrEnum):
     STALE = 'stale'
     DUPLICATE = 'duplicate'
     UNKNOWN = 'unknown'
-
-
-# Robot modes as agents report them; the tracker only needs to tell these apart.
-TRAVELLING = 'travelling'
-WORKING = 'working'
-OFFLINE = 'offline'
-UNHEALTHY_MODES = frozenset({'failed', OFFLINE})
 
 
 @dataclass
@@ -66,7 +53,8 @@ class JobRecord:
 @dataclass
 class RobotRecord:
     name: str
-    mode: str = ''
+    mode: RobotMode | None = None
+    """None until it reports."""
     location: str = ''
     destination: str = ''
     busy_until: float = math.nan
@@ -77,7 +65,7 @@ class RobotRecord:
     def healthy(self) -> bool:
         """Failed or offline robots are not; one that has not reported yet is taken to be
         (it gets its tasks when it joins)."""
-        return self.mode not in UNHEALTHY_MODES
+        return self.mode is None or self.mode.healthy
 
 
 @dataclass(frozen=True)
@@ -190,7 +178,7 @@ class MissionTracker:
             return Outcome(Ignored.UNKNOWN, f"event '{event_id}' has invalid time {time}")
         return None
 
-    def record_robot_state(self, robot: str, mode: str, location: str, destination: str,
+    def record_robot_state(self, robot: str, mode: RobotMode, location: str, destination: str,
                            busy_until: float, current_job: str = '') -> Outcome:
         if robot not in self.robots:
             repeated = robot in self._unknown_robots
@@ -199,13 +187,13 @@ class MissionTracker:
                 self.ignored[Ignored.UNKNOWN] += 1
             return Outcome(Ignored.UNKNOWN, f"state of unknown robot '{robot}'",
                            repeated=repeated)
-        self.robots[robot] = RobotRecord(robot, mode, location, destination, busy_until,
+        self.robots[robot] = RobotRecord(robot, RobotMode(mode), location, destination, busy_until,
                                          current_job, True)
         return Outcome()
 
     def mark_offline(self, robot: str) -> None:
         """Its heartbeat was lost: treated as failed until it reports again."""
-        self.robots[robot].mode = OFFLINE
+        self.robots[robot].mode = RobotMode.OFFLINE
 
     # --- what the reports add up to ------------------------------------------------------
 
@@ -274,8 +262,8 @@ class MissionTracker:
     def _reported_end(self, job: str) -> Fraction:
         """The latest end its working robots expect for their operations (0: none said)."""
         ends = [Fraction(r.busy_until) for r in self.robots.values()
-                if r.current_job == job and r.mode == WORKING and math.isfinite(r.busy_until)
-                and r.name not in self.jobs[job].operation_done]
+                if r.current_job == job and r.mode == RobotMode.WORKING
+                and math.isfinite(r.busy_until) and r.name not in self.jobs[job].operation_done]
         return max(ends, default=Fraction(0))
 
     def projected_makespan(self, now: float) -> Fraction:
@@ -324,7 +312,7 @@ class MissionTracker:
             on = [j for j, a in running.items() if name in a.robots]
             if on:
                 location, free_at = self.problem.job(on[0]).location, running[on[0]].end
-            elif r.mode == TRAVELLING and r.destination:
+            elif r.mode == RobotMode.TRAVELLING and r.destination:
                 arrival = r.busy_until if math.isfinite(r.busy_until) else now
                 location, free_at = r.destination, max(Fraction(arrival), now_f)
             else:

@@ -2,19 +2,10 @@
 
 import math
 
-from fjsp_msgs.msg import JobState, Plan, PlanTask, RobotPlan, TaskEvent
+from fjsp_msgs.msg import JobState, Plan, PlanTask, RobotPlan
 from fjsp_planner.core.problem import Problem
 from fjsp_planner.core.schedule import Result, Schedule
-from fjsp_planner.core.tracking import EventKind, MissionTracker
-
-EVENT_KINDS = {
-    TaskEvent.KIND_ARRIVED: EventKind.ARRIVED,
-    TaskEvent.KIND_STARTED: EventKind.STARTED,
-    TaskEvent.KIND_OPERATION_DONE: EventKind.OPERATION_DONE,
-    TaskEvent.KIND_ABORTED: EventKind.ABORTED,
-}
-MODE_NAMES = ('idle', 'travelling', 'waiting', 'working', 'holding', 'failed', 'offline')
-"""RobotState.MODE_* values, in order, as the core names them."""
+from fjsp_planner.core.tracking import MissionTracker
 
 
 def _float(value) -> float:
@@ -22,8 +13,8 @@ def _float(value) -> float:
 
 
 def plan_msg(scenario: Problem, posed: Problem, schedule: Schedule, result: Result,
-             revision: int, mission_start, time_scale: float, stamp,
-             continued=frozenset()) -> Plan:
+             mission_id: str, revision: int, mission_start, time_scale: float, stamp,
+             continued=frozenset(), reasons=()) -> Plan:
     """The plan message of a schedule of `posed`: every robot's tasks with travel, times and
     partners. `posed` is the scenario itself, or what remained of it at a re-plan; every
     robot of the scenario is listed, the ones left out of `posed` with no task."""
@@ -52,7 +43,8 @@ def plan_msg(scenario: Problem, posed: Problem, schedule: Schedule, result: Resu
                 and holds.get((visit.job, q)) == following,
                 continued=visit.job in continued))
         robots.append(RobotPlan(robot=robot.name, robot_type=robot.type, tasks=tasks))
-    return Plan(stamp=stamp, revision=revision, scenario_id=scenario.name,
+    return Plan(stamp=stamp, mission_id=mission_id, revision=revision,
+                scenario_id=scenario.name, reasons=list(reasons),
                 mission_start=mission_start, time_scale=time_scale,
                 makespan=float(result.makespan), solver_status=str(result.status),
                 lower_bound=_float(result.lower_bound), robots=robots)

@@ -15,42 +15,39 @@ import rclpy
 from rclpy.node import Node
 from rclpy.time import Time
 
-from fjsp_msgs.msg import MissionStatus, Plan, RobotState, TaskEvent
-from fjsp_planner.nodes.conversions import MODE_NAMES
-from fjsp_planner.nodes.interfaces import (
+from fjsp_common.contract import (
     EVENTS_QOS,
     LATCHED_QOS,
     MISSION_STATUS_TOPIC,
+    MODE_FROM_MSG,
     PLAN_TOPIC,
+    ROBOT_STATES_QOS,
     ROBOT_STATES_TOPIC,
+    STATE_FROM_MSG,
     TASK_EVENTS_TOPIC,
 )
-from fjsp_planner.nodes.running import ParameterError, declared, run_node
-
-STATE_NAMES = {
-    MissionStatus.STATE_WAITING_FOR_ROBOTS: 'waiting for robots',
-    MissionStatus.STATE_PLANNING: 'planning',
-    MissionStatus.STATE_EXECUTING: 'executing',
-    MissionStatus.STATE_REPLANNING: 'replanning',
-    MissionStatus.STATE_BLOCKED: 'blocked',
-    MissionStatus.STATE_COMPLETE: 'complete',
-    MissionStatus.STATE_FAILED: 'failed',
-}
+from fjsp_common.running import declare, run_node
+from fjsp_msgs.msg import MissionStatus, Plan, RobotState, TaskEvent
 
 
 class MonitorNode(Node):
     def __init__(self):
         super().__init__('monitor')
-        self.gantt_dir = Path(declared(self, 'gantt_dir', '.')).expanduser()
-        refresh_period = declared(self, 'refresh_period', 1.0)
-        self.heartbeat_timeout = declared(self, 'heartbeat_timeout', 1.0)
-        self.exit_on_complete = declared(self, 'exit_on_complete', False)
+        self.gantt_dir = Path(declare(self, 'gantt_dir', '.',
+                                      'directory the Gantt charts are written to')).expanduser()
+        refresh_period = declare(self, 'refresh_period', 1.0,
+                                 'seconds between refreshes of the view', low=0.05, high=60.0)
+        self.heartbeat_timeout = declare(
+            self, 'heartbeat_timeout', 1.0,
+            'seconds without a robot state before the robot shows offline', low=0.05,
+            high=600.0)
+        self.exit_on_complete = declare(self, 'exit_on_complete', False,
+                                        'exit once the mission is complete and drawn')
         # Events may reach a late joiner after the status saying the mission is complete.
-        self.event_grace = declared(self, 'event_grace', 3.0)
-        for name, value in (('refresh_period', refresh_period),
-                            ('heartbeat_timeout', self.heartbeat_timeout)):
-            if not value > 0:
-                raise ParameterError(f"parameter '{name}' must be > 0, got {value}")
+        self.event_grace = declare(
+            self, 'event_grace', 3.0,
+            'seconds to wait for late task events once the mission is complete', low=0.0,
+            high=600.0)
         self.plan: Plan | None = None
         self.status: MissionStatus | None = None
         self.robots: dict[str, RobotState] = {}
@@ -65,7 +62,8 @@ class MonitorNode(Node):
         self.finished = False
 
         self.create_subscription(Plan, PLAN_TOPIC, self.on_plan, LATCHED_QOS)
-        self.create_subscription(RobotState, ROBOT_STATES_TOPIC, self.on_robot, LATCHED_QOS)
+        self.create_subscription(RobotState, ROBOT_STATES_TOPIC, self.on_robot,
+                                 ROBOT_STATES_QOS)
         self.create_subscription(MissionStatus, MISSION_STATUS_TOPIC, self.on_status,
                                  LATCHED_QOS)
         self.create_subscription(TaskEvent, TASK_EVENTS_TOPIC, self.on_event, EVENTS_QOS)
@@ -103,7 +101,7 @@ class MonitorNode(Node):
         else:
             lines.append(
                 f'mission {s.scenario_id} rev {s.plan_revision}: '
-                f'{STATE_NAMES.get(s.state, s.state)}, {s.jobs_done}/{s.jobs_total} jobs '
+                f'{STATE_FROM_MSG.get(s.state, s.state)}, {s.jobs_done}/{s.jobs_total} jobs '
                 f'done, {s.jobs_running} running, makespan planned {s.planned_makespan:.2f} '
                 f'projected {s.projected_makespan:.2f}, t={s.elapsed:.1f}'
                 + (f', ignored {s.ignored_stale} stale / {s.ignored_duplicate} duplicate / '
@@ -121,10 +119,8 @@ class MonitorNode(Node):
             silent = (now - self.heard[name]).nanoseconds * 1e-9
             if silent > self.heartbeat_timeout:
                 mode = 'offline'
-            elif r.mode < len(MODE_NAMES):
-                mode = MODE_NAMES[r.mode]
             else:
-                mode = f'mode {r.mode}'
+                mode = MODE_FROM_MSG.get(r.mode, f'mode {r.mode}')
             where = (f'{r.location or "?"} -> {r.destination}' if r.destination
                      else r.location or '-')
             lines.append(f'  {name:<10} {mode:<10} job {r.current_job or "-":<4} '

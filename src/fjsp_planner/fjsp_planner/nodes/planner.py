@@ -3,9 +3,11 @@ tracks its execution from the robots' reports, and re-plans what remains when a 
 goes silent, recovers or runs late (see docs/ros-interfaces.md)."""
 
 import math
+import secrets
 import sys
 import time
 from concurrent.futures import Future, ThreadPoolExecutor
+from datetime import UTC, datetime
 from pathlib import Path
 
 from ament_index_python.packages import PackageNotFoundError, get_package_share_directory
@@ -13,25 +15,36 @@ from rclpy.duration import Duration
 from rclpy.node import Node
 from rclpy.time import Time
 
+from fjsp_common.contract import (
+    EVENT_FROM_MSG,
+    EVENTS_QOS,
+    JOB_STATES_TOPIC,
+    LATCHED_QOS,
+    MISSION_STATUS_TOPIC,
+    MODE_FROM_MSG,
+    PLAN_TOPIC,
+    ROBOT_STATES_QOS,
+    ROBOT_STATES_TOPIC,
+    TASK_EVENTS_TOPIC,
+)
+from fjsp_common.running import ParameterError, declare, run_node, shorten
+from fjsp_common.vocabulary import RobotMode
 from fjsp_msgs.msg import JobStates, MissionStatus, Plan, RobotState, TaskEvent
 from fjsp_planner.core.problem import Problem, ProblemError
 from fjsp_planner.core.replan import Replan, replan
 from fjsp_planner.core.scenario import load_scenario
 from fjsp_planner.core.schedule import Result, Schedule
-from fjsp_planner.core.solve import solve
-from fjsp_planner.core.tracking import OFFLINE, Ignored, MissionTracker
+from fjsp_planner.core.solve import SOLVERS, solve
+from fjsp_planner.core.tracking import Ignored, MissionTracker
 from fjsp_planner.core.validate import validate
-from fjsp_planner.nodes.conversions import EVENT_KINDS, MODE_NAMES, job_states, plan_msg
-from fjsp_planner.nodes.interfaces import (
-    EVENTS_QOS,
-    JOB_STATES_TOPIC,
-    LATCHED_QOS,
-    MISSION_STATUS_TOPIC,
-    PLAN_TOPIC,
-    ROBOT_STATES_TOPIC,
-    TASK_EVENTS_TOPIC,
-)
-from fjsp_planner.nodes.running import ParameterError, declared, run_node
+from fjsp_planner.nodes.conversions import job_states, plan_msg
+
+
+def new_mission_id(scenario: str) -> str:
+    """Unique, and sorting by start time: `<scenario>-<UTC time>-<random>`."""
+    stamp = datetime.now(UTC).strftime('%Y%m%dT%H%M%S')
+    name = ''.join(c if c.isalnum() or c in '_-' else '_' for c in scenario)[:40]
+    return f'{name}-{stamp}-{secrets.token_hex(2)}'
 
 
 def default_scenario() -> str:
@@ -46,30 +59,42 @@ def default_scenario() -> str:
 class PlannerNode(Node):
     def __init__(self):
         super().__init__('planner')
-        scenario = declared(self, 'scenario', '') or default_scenario()
-        panels = declared(self, 'panels', 0)
-        shift = declared(self, 'shift', -1.0)
-        self.solver = declared(self, 'solver', 'cpsat')
-        self.time_limit = declared(self, 'time_limit', 10.0)
-        self.replan_time_limit = declared(self, 'replan_time_limit', 1.0)
-        self.workers = declared(self, 'workers', 2)
-        self.heartbeat_timeout = declared(self, 'heartbeat_timeout', 1.0)
-        self.delay_threshold = declared(self, 'delay_threshold', 2.0)
-        self.time_scale = declared(self, 'time_scale', 0.05)
-        self.robot_wait_timeout = declared(self, 'robot_wait_timeout', 15.0)
-        self.start_delay = declared(self, 'start_delay', 0.5)
-        status_period = declared(self, 'status_period', 0.5)
-        for name, value, low in (('panels', panels, 0), ('time_limit', self.time_limit, 1e-9),
-                                 ('replan_time_limit', self.replan_time_limit, 1e-9),
-                                 ('heartbeat_timeout', self.heartbeat_timeout, 1e-9),
-                                 ('delay_threshold', self.delay_threshold, 0),
-                                 ('workers', self.workers, 1),
-                                 ('time_scale', self.time_scale, 1e-9),
-                                 ('robot_wait_timeout', self.robot_wait_timeout, 0),
-                                 ('start_delay', self.start_delay, 0),
-                                 ('status_period', status_period, 1e-9)):
-            if not value >= low:
-                raise ParameterError(f"parameter '{name}' must be >= {low:g}, got {value}")
+        scenario = declare(self, 'scenario', '',
+                           'scenario file of the mission to run at start-up') \
+            or default_scenario()
+        panels = declare(self, 'panels', 0, "panels of the scenario's job set; 0: the file's",
+                         low=0, high=50)
+        shift = declare(self, 'shift', -1.0,
+                        "distance added per panel apart; negative: the file's", low=-1.0,
+                        high=1e6)
+        self.solver = declare(self, 'solver', 'cpsat', 'solver of the first plan',
+                              constraints='one of: ' + ', '.join(SOLVERS))
+        if self.solver not in SOLVERS:
+            raise ParameterError(f"parameter 'solver' must be one of {', '.join(SOLVERS)}, "
+                                 f'got {shorten(self.solver, 80)!r}')
+        declare(self, 'time_limit', 10.0, 'seconds the first plan may take', low=0.01,
+                high=3600.0, read_only=False)
+        declare(self, 'replan_time_limit', 1.0, 'seconds a re-plan may take', low=0.01,
+                high=600.0, read_only=False)
+        declare(self, 'workers', 2, 'CP-SAT search workers', low=1, high=64, read_only=False)
+        declare(self, 'heartbeat_timeout', 1.0,
+                'seconds without a robot state before a robot is offline', low=0.05,
+                high=600.0, read_only=False)
+        declare(self, 'delay_threshold', 2.0,
+                'schedule units an operation may run late before a re-plan', low=0.0,
+                high=1e6, read_only=False)
+        self.time_scale = declare(self, 'time_scale', 0.05,
+                                  'wall seconds per schedule unit', low=1e-4, high=1000.0)
+        self.robot_wait_timeout = declare(
+            self, 'robot_wait_timeout', 15.0,
+            'seconds to wait for every robot to report before planning without it',
+            low=0.0, high=3600.0)
+        self.start_delay = declare(self, 'start_delay', 0.5,
+                                   'seconds from the first plan to the mission start',
+                                   low=0.0, high=3600.0)
+        status_period = declare(self, 'status_period', 0.5,
+                                'seconds between periodic status publications', low=0.01,
+                                high=60.0)
         try:
             self.problem: Problem = load_scenario(scenario, panels=panels or None,
                                                   shift=shift if shift >= 0 else None)
@@ -81,6 +106,7 @@ class PlannerNode(Node):
                  f'{len(self.problem.jobs)} jobs, robots '
                  + ', '.join(r.name for r in self.problem.robots))
 
+        self.mission_id = new_mission_id(self.problem.name)
         self.tracker = MissionTracker(self.problem)
         self.state = MissionStatus.STATE_WAITING_FOR_ROBOTS
         self.blocked: list[str] = []
@@ -88,6 +114,7 @@ class PlannerNode(Node):
         self.schedule: Schedule | None = None
         self.mission_start: Time | None = None
         self.job_done_ids: set[str] = set()
+        self.foreign_missions: set[str] = set()
         self.solving: Future | None = None
         self.planned_health: frozenset[str] = frozenset()
         """The robots the current plan (or the blocked verdict) took as healthy."""
@@ -103,12 +130,19 @@ class PlannerNode(Node):
         self.jobs_pub = self.create_publisher(JobStates, JOB_STATES_TOPIC, LATCHED_QOS)
         self.event_pub = self.create_publisher(TaskEvent, TASK_EVENTS_TOPIC, EVENTS_QOS)
         self.create_subscription(RobotState, ROBOT_STATES_TOPIC, self.on_robot_state,
-                                 LATCHED_QOS)
+                                 ROBOT_STATES_QOS)
         self.create_subscription(TaskEvent, TASK_EVENTS_TOPIC, self.on_event, EVENTS_QOS)
         self.create_subscription(Plan, PLAN_TOPIC, self.on_plan, LATCHED_QOS)
         self.create_timer(0.1, self.tick)
         self.create_timer(status_period, self.publish_periodic)
         self.publish_status()
+
+    # Parameters the node honours when they are set at run time: read at each use.
+    time_limit = property(lambda self: self.get_parameter('time_limit').value)
+    replan_time_limit = property(lambda self: self.get_parameter('replan_time_limit').value)
+    workers = property(lambda self: self.get_parameter('workers').value)
+    heartbeat_timeout = property(lambda self: self.get_parameter('heartbeat_timeout').value)
+    delay_threshold = property(lambda self: self.get_parameter('delay_threshold').value)
 
     # --- time ------------------------------------------------------------------------
 
@@ -254,9 +288,9 @@ class PlannerNode(Node):
         now = self.get_clock().now()
         if self.mission_start is None:
             self.mission_start = now + Duration(nanoseconds=int(self.start_delay * 1e9))
-        self.plan = plan_msg(self.problem, posed, result.schedule, result, revision,
-                             self.mission_start.to_msg(), self.time_scale, now.to_msg(),
-                             continued)
+        self.plan = plan_msg(self.problem, posed, result.schedule, result, self.mission_id,
+                             revision, self.mission_start.to_msg(), self.time_scale,
+                             now.to_msg(), continued)
         self.plan_pub.publish(self.plan)
         self.state = MissionStatus.STATE_EXECUTING
         gap = f', gap {result.gap:.1%}' if result.gap is not None else ''
@@ -288,7 +322,7 @@ class PlannerNode(Node):
             return
         for robot, heard in self.last_heard.items():
             record = self.tracker.robots[robot]
-            if record.mode != OFFLINE and now - heard > self.heartbeat_timeout:
+            if record.mode != RobotMode.OFFLINE and now - heard > self.heartbeat_timeout:
                 self.tracker.mark_offline(robot)
                 self.get_logger().error(f"robot '{robot}' offline: no state for "
                                         f'{now - heard:.1f} s; treated as failed')
@@ -307,9 +341,12 @@ class PlannerNode(Node):
         self.publish_status()
 
     def on_robot_state(self, msg: RobotState) -> None:
-        mode = MODE_NAMES[msg.mode] if msg.mode < len(MODE_NAMES) else f'mode {msg.mode}'
+        mode = MODE_FROM_MSG.get(msg.mode)
+        if mode is None:
+            self.tracker.ignored[Ignored.UNKNOWN] += 1
+            return
         was_offline = msg.robot in self.tracker.robots \
-            and self.tracker.robots[msg.robot].mode == OFFLINE
+            and self.tracker.robots[msg.robot].mode == RobotMode.OFFLINE
         outcome = self.tracker.record_robot_state(msg.robot, mode, msg.location,
                                                   msg.destination, msg.busy_until,
                                                   msg.current_job)
@@ -322,6 +359,15 @@ class PlannerNode(Node):
             self.get_logger().warning(f"robot '{msg.robot}' reports again ({mode})")
 
     def on_event(self, msg: TaskEvent) -> None:
+        if msg.mission_id != self.mission_id:
+            self.tracker.ignored[Ignored.STALE] += 1
+            if msg.mission_id not in self.foreign_missions:
+                self.foreign_missions.add(msg.mission_id)
+                self.get_logger().warning(
+                    f"ignoring events of mission '{shorten(msg.mission_id, 80)}': this planner "
+                    f"runs mission '{self.mission_id}'")
+            self.publish_status()
+            return
         if msg.kind == TaskEvent.KIND_JOB_DONE:
             if msg.event_id not in self.job_done_ids:
                 self.tracker.ignored[Ignored.UNKNOWN] += 1
@@ -329,25 +375,25 @@ class PlannerNode(Node):
                                           ' only the planner declares jobs done')
                 self.publish_status()
             return
-        if msg.kind not in EVENT_KINDS:
+        if msg.kind not in EVENT_FROM_MSG:
             self.tracker.ignored[Ignored.UNKNOWN] += 1
             self.get_logger().warning(f"ignoring unknown event '{msg.event_id}': kind "
                                       f'{msg.kind} is not a TaskEvent kind')
             self.publish_status()
             return
-        outcome = self.tracker.record_event(msg.event_id, EVENT_KINDS[msg.kind], msg.robot,
+        outcome = self.tracker.record_event(msg.event_id, EVENT_FROM_MSG[msg.kind], msg.robot,
                                             msg.job, msg.plan_revision, msg.time)
         if outcome.ignored:
             self.ignored(outcome, 'event')
             return
         if outcome.job_done is not None:
             job, end = outcome.job_done
-            event_id = f'planner/{job}/job_done/{self.tracker.revision}'
+            event_id = f'planner/{self.mission_id}/{job}/job_done/{self.tracker.revision}'
             self.job_done_ids.add(event_id)
             self.event_pub.publish(TaskEvent(
                 stamp=self.get_clock().now().to_msg(), event_id=event_id,
-                kind=TaskEvent.KIND_JOB_DONE, job=job, plan_revision=self.tracker.revision,
-                time=end))
+                mission_id=self.mission_id, kind=TaskEvent.KIND_JOB_DONE, job=job,
+                plan_revision=self.tracker.revision, time=end))
             done = len(self.tracker.done)
             self.get_logger().info(f'job {job} done at t={end:.2f} ({done}/'
                                    f'{len(self.tracker.jobs)})')
@@ -380,6 +426,7 @@ class PlannerNode(Node):
 
     def publish_jobs(self) -> None:
         self.jobs_pub.publish(JobStates(stamp=self.get_clock().now().to_msg(),
+                                        mission_id=self.mission_id,
                                         plan_revision=self.tracker.revision,
                                         jobs=job_states(self.tracker)))
 
@@ -392,7 +439,7 @@ class PlannerNode(Node):
         if self.state == MissionStatus.STATE_WAITING_FOR_ROBOTS:
             blocked = [f"waiting for robot '{r}' to report" for r in tracker.missing_robots]
         self.status_pub.publish(MissionStatus(
-            stamp=self.get_clock().now().to_msg(), state=self.state,
+            stamp=self.get_clock().now().to_msg(), mission_id=self.mission_id, state=self.state,
             plan_revision=tracker.revision, scenario_id=self.problem.name,
             jobs_done=len(tracker.done), jobs_running=len(tracker.running),
             jobs_total=len(tracker.jobs), planned_makespan=planned,
