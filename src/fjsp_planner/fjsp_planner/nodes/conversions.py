@@ -50,6 +50,16 @@ def plan_msg(scenario: Problem, posed: Problem, schedule: Schedule, result: Resu
                 lower_bound=_float(result.lower_bound), robots=robots)
 
 
+def cancel_msg(scenario: Problem, mission_id: str, revision: int, mission_start,
+               time_scale: float, stamp, reasons=()) -> Plan:
+    """The revision that cancels a mission: every robot listed, with no task."""
+    return Plan(stamp=stamp, mission_id=mission_id, revision=revision,
+                scenario_id=scenario.name, mission_start=mission_start, time_scale=time_scale,
+                cancelled=True, makespan=math.nan, solver_status='cancelled',
+                lower_bound=math.nan, reasons=list(reasons),
+                robots=[RobotPlan(robot=r.name, robot_type=r.type) for r in scenario.robots])
+
+
 def job_states(tracker: MissionTracker) -> list[JobState]:
     states = []
     for name, record in tracker.jobs.items():

@@ -1,0 +1,678 @@
+"""The mission as the planner runs it, without ROS: what to plan, when to re-plan, when a
+mission is over.
+
+The planner node feeds a `MissionController` what it hears (robot states, task events), what
+it is asked (start or cancel a mission) and the passing of time (`tick`), and carries out the
+`Effect`s each call returns: run a solve off the executor, publish a plan, declare a job done,
+tell the story of the mission (`Note`). All times in are wall seconds of one clock (the ROS
+clock); schedule time is derived from the mission start and the time scale.
+
+A robot takes part in planning only while it is *available*: it has reported, it is neither
+failed nor offline, and it follows the plans it is given (an agent that refuses a plan, e.g.
+for a robot type it cannot play, is left out and named in the warnings). The plan records, for
+each robot it counted on, the agent incarnation and failure count it saw; a robot that fails
+and recovers between two ticks, or whose agent restarts, lost its tasks even though it looks
+healthy, and is re-planned in. A robot whose heartbeat is lost is offline until it has been
+heard again for a full heartbeat timeout, so that one late heartbeat does not re-plan twice.
+"""
+
+import math
+from collections import Counter
+from dataclasses import dataclass, field, replace
+from fractions import Fraction
+
+from fjsp_common.vocabulary import EventKind, MissionEventKind, MissionState, RobotMode
+from fjsp_planner.core.problem import Problem
+from fjsp_planner.core.replan import ExecutionState, Replan, RobotState, residual_problem
+from fjsp_planner.core.schedule import Result, Schedule
+from fjsp_planner.core.tracking import Ignored, MissionTracker
+from fjsp_planner.core.validate import validate
+
+STARVED = 0.25
+"""Seconds between two ticks beyond which the node could not take messages for a while: the
+heartbeats it has not processed yet come first, before any robot is judged silent."""
+
+
+@dataclass(frozen=True)
+class Settings:
+    """How the planner runs missions; the node refreshes them when its parameters change."""
+
+    time_limit: float = 10.0
+    replan_time_limit: float = 1.0
+    heartbeat_timeout: float = 1.0
+    delay_threshold: float = 2.0
+    robot_wait_timeout: float = 15.0
+    start_delay: float = 0.5
+    time_scale: float = 0.05
+    blocked_timeout: float = 0.0
+    """Seconds a mission may stay blocked before it fails; 0: it waits for the fleet."""
+
+
+@dataclass(frozen=True)
+class RobotReport:
+    """One RobotState as the controller needs it."""
+
+    robot: str
+    mode: RobotMode
+    incarnation: int = 0
+    mission_id: str = ''
+    revision: int = 0
+    refusal: str = ''
+    failures: int = 0
+    robot_type: str = ''
+    location: str = ''
+    destination: str = ''
+    busy_until: float = math.nan
+    current_job: str = ''
+
+
+@dataclass(frozen=True)
+class EventReport:
+    """One TaskEvent of an agent."""
+
+    event_id: str
+    mission_id: str
+    kind: EventKind
+    robot: str
+    job: str
+    revision: int
+    time: float
+
+
+def executed_violations(tracker: MissionTracker) -> list[str]:
+    """What the executed timeline breaks (precedence, holding, staffing, travel). Robots
+    count as starting wherever their first job was, at any time: across re-plans and
+    successive missions, that is where they were."""
+    free = replace(tracker.problem, robots=tuple(
+        replace(r, start_location=None, release_time=Fraction(0))
+        for r in tracker.problem.robots))
+    return validate(free, tracker.executed_schedule())
+
+
+# --- effects: what the node must do ----------------------------------------------------
+
+@dataclass(frozen=True)
+class Solve:
+    """Run a solve off the executor and hand its outcome to `MissionController.solved`.
+
+    kind 'plan': `solve(problem)`; kind 'replan': `replan(problem, previous, state)`."""
+
+    token: int
+    kind: str
+    problem: Problem
+    time_limit: float
+    previous: Schedule | None = None
+    state: ExecutionState | None = None
+    reasons: tuple[str, ...] = ()
+    """Why a re-plan is needed."""
+
+
+@dataclass(frozen=True)
+class PublishPlan:
+    revision: int
+    posed: Problem
+    """What was solved: the mission's problem, or what remained of it."""
+    result: Result | None
+    """None for the revision that cancels a mission."""
+    continued: frozenset[str]
+    reasons: tuple[str, ...]
+    mission_start: float
+    """Wall seconds of schedule time 0."""
+    cancelled: bool = False
+
+
+@dataclass(frozen=True)
+class JobDone:
+    job: str
+    time: float
+    revision: int
+
+
+@dataclass(frozen=True)
+class Note:
+    """Something the mission's story must tell (a MissionEvent)."""
+
+    kind: MissionEventKind
+    reasons: tuple[str, ...] = ()
+    robot: str = ''
+    job: str = ''
+
+
+Effect = Solve | PublishPlan | JobDone | Note
+
+
+@dataclass(frozen=True)
+class StatusView:
+    mission_id: str
+    scenario: str
+    state: MissionState
+    revision: int
+    jobs_done: int
+    jobs_running: int
+    jobs_total: int
+    planned_makespan: float
+    projected_makespan: float
+    elapsed: float
+    blocked: tuple[str, ...]
+    replan_reasons: tuple[str, ...]
+    warnings: tuple[str, ...]
+    ignored: Counter
+
+
+# --- what the controller keeps ---------------------------------------------------------
+
+@dataclass
+class _Agent:
+    """What is known of one robot's agent, across missions."""
+
+    report: RobotReport
+    heard: float
+    """Wall seconds of the latest state received."""
+    offline_since: float | None = None
+    back_since: float | None = None
+    """First report after an offline spell: it counts again a heartbeat timeout later."""
+
+
+@dataclass
+class _Solving:
+    token: int
+    kind: str
+    problem: Problem
+    """What was posed: for a first plan, the problem the schedule will be of."""
+    fleet: dict[str, tuple[int, int]]
+    """The available robots it plans for: (incarnation, failures) as seen when posed."""
+    reasons: tuple[str, ...]
+    state: ExecutionState | None = None
+
+
+@dataclass
+class _Mission:
+    id: str
+    problem: Problem
+    settings: Settings
+    tracker: MissionTracker
+    accepted: float
+    """Wall seconds when the mission was accepted."""
+    state: MissionState = MissionState.WAITING_FOR_ROBOTS
+    start: float | None = None
+    """Wall seconds of schedule time 0, fixed when revision 1 is published."""
+    schedule: Schedule | None = None
+    planned_makespan: float = math.nan
+    planned: dict[str, tuple[int, int]] = field(default_factory=dict)
+    """The robots the current plan (or blocked verdict) counts on: (incarnation, failures)."""
+    solving: _Solving | None = None
+    replan_reasons: tuple[str, ...] = ()
+    blocked: tuple[str, ...] = ()
+    failure: tuple[str, ...] = ()
+    blocked_since: float | None = None
+    foreign: set[str] = field(default_factory=set)
+    """Other missions whose events arrived: each is logged once."""
+    warned: set[str] = field(default_factory=set)
+    pending: tuple[str, ...] = ()
+    """Reasons of a re-plan that was discarded: the next tick plans again."""
+
+
+class MissionController:
+    def __init__(self, settings: Settings = Settings()):
+        self.settings = settings
+        self.agents: dict[str, _Agent] = {}
+        self.mission: _Mission | None = None
+        self._tokens = 0
+        self._last_tick: float | None = None
+
+    # --- commands ------------------------------------------------------------------------
+
+    def start(self, problem: Problem, mission_id: str, wall: float,
+              settings: Settings | None = None) -> list[Effect]:
+        """Accept a mission; raises ValueError while another one runs."""
+        if self.mission is not None and not self.mission.state.ended:
+            raise ValueError(f"mission '{self.mission.id}' is {self.mission.state}: one "
+                             'mission per fleet at a time')
+        self.mission = _Mission(mission_id, problem, settings or self.settings,
+                                MissionTracker(problem), wall)
+        robots = ', '.join(r.name for r in problem.robots)
+        effects = [Note(MissionEventKind.MISSION_STARTED,
+                        (f"scenario '{problem.name}': {len(problem.jobs)} jobs, robots "
+                         f'{robots}',))]
+        return effects + self.tick(wall)
+
+    def cancel(self, reason: str, wall: float) -> list[Effect]:
+        """Stop the running mission: the robots are told to drop their tasks."""
+        mission = self.mission
+        if mission is None or mission.state.ended:
+            raise ValueError('no mission is running')
+        mission.solving = None
+        mission.state = MissionState.CANCELLED
+        mission.failure = (reason,)
+        effects: list[Effect] = [Note(MissionEventKind.MISSION_CANCELLED, (reason,))]
+        if mission.start is not None:
+            revision = mission.tracker.revision + 1
+            mission.tracker.revision = revision
+            effects.insert(0, PublishPlan(revision, mission.problem, None, frozenset(),
+                                          (reason,), mission.start, cancelled=True))
+        return effects
+
+    # --- what the fleet reports ----------------------------------------------------------
+
+    def robot_state(self, report: RobotReport, wall: float) -> list[Effect]:
+        agent = self.agents.get(report.robot)
+        effects: list[Effect] = []
+        if agent is None:
+            self.agents[report.robot] = _Agent(report, wall)
+        else:
+            if agent.offline_since is not None and agent.back_since is None:
+                agent.back_since = wall
+            agent.report, agent.heard = report, wall
+        mission = self.mission
+        if mission is None:
+            return effects
+        if report.robot not in mission.tracker.robots:
+            outcome = mission.tracker.record_robot_state(report.robot, report.mode, '', '',
+                                                         math.nan)
+            if not outcome.repeated:
+                effects.append(Note(MissionEventKind.WARNING, (self._unknown(report.robot),),
+                                    robot=report.robot))
+            return effects
+        before = mission.tracker.robots[report.robot].mode
+        mission.tracker.record_robot_state(report.robot, report.mode, report.location,
+                                           report.destination, report.busy_until,
+                                           report.current_job)
+        if report.mode == RobotMode.FAILED and before != RobotMode.FAILED:
+            effects.append(Note(MissionEventKind.ROBOT_FAILED, robot=report.robot))
+        if report.refusal and report.refusal not in mission.warned:
+            mission.warned.add(report.refusal)
+            effects.append(Note(MissionEventKind.WARNING,
+                                (f"robot '{report.robot}' refuses its plan: {report.refusal}",),
+                                robot=report.robot))
+        self._mark_offline_as_heard(report.robot)
+        return effects
+
+    def task_event(self, event: EventReport, wall: float) -> tuple[list[Effect], str]:
+        """Use one agent's event; the second item says why it was ignored ('' if used)."""
+        mission = self.mission
+        if mission is None:
+            return [], ''
+        tracker = mission.tracker
+        if event.mission_id != mission.id:
+            tracker.ignored[Ignored.STALE] += 1
+            if event.mission_id in mission.foreign:
+                return [], ''
+            mission.foreign.add(event.mission_id)
+            return [], (f"events of mission '{event.mission_id}': this planner runs mission "
+                        f"'{mission.id}'")
+        if event.kind == EventKind.JOB_DONE:
+            tracker.ignored[Ignored.UNKNOWN] += 1
+            return [], (f"job-done event '{event.event_id}': only the planner declares jobs "
+                        'done')
+        aborted_before = event.job in tracker.aborted
+        outcome = tracker.record_event(event.event_id, event.kind, event.robot, event.job,
+                                       event.revision, event.time)
+        if outcome.ignored:
+            return [], f'{outcome.ignored} event: {outcome.reason}'
+        effects: list[Effect] = []
+        if event.kind == EventKind.ABORTED and not aborted_before \
+                and event.job in tracker.aborted:
+            effects.append(Note(MissionEventKind.JOB_ABORTED,
+                                (f"robot '{event.robot}' aborted it",), job=event.job))
+        if outcome.job_done is not None:
+            job, end = outcome.job_done
+            effects.append(JobDone(job, end, tracker.revision))
+            if tracker.complete and not mission.state.ended:
+                effects += self._complete(mission)
+        return effects, ''
+
+    # --- time passing --------------------------------------------------------------------
+
+    def tick(self, wall: float, subscribers: int | None = None) -> list[Effect]:
+        """Judge heartbeats, start what is due. `subscribers` counts the plan topic's
+        matched readers: the first plan waits until every robot can hear it."""
+        starved = self._last_tick is not None and wall - self._last_tick > STARVED
+        self._last_tick = wall
+        effects: list[Effect] = []
+        if not starved:
+            effects += self._check_heartbeats(wall)
+        mission = self.mission
+        if mission is None or mission.state.ended or mission.solving is not None:
+            return effects
+        if mission.state == MissionState.WAITING_FOR_ROBOTS:
+            waited = wall - mission.accepted
+            heard = all(self._heard(r.name) for r in mission.problem.robots)
+            unmatched = subscribers is not None and subscribers < len(mission.problem.robots)
+            if (not heard or unmatched) and waited < mission.settings.robot_wait_timeout:
+                return effects
+            return effects + self._plan(mission, wall)
+        if mission.state in (MissionState.EXECUTING, MissionState.BLOCKED):
+            reasons = self._replan_reasons(mission, wall)
+            if mission.pending:
+                reasons, mission.pending = list(mission.pending) + reasons, ()
+            if reasons and mission.schedule is None:
+                # Blocked before the first plan: plan afresh once the fleet changes.
+                return effects + self._plan(mission, wall)
+            if reasons:
+                return effects + self._replan(mission, wall, tuple(reasons))
+            timeout = mission.settings.blocked_timeout
+            if mission.state == MissionState.BLOCKED and timeout > 0 \
+                    and wall - mission.blocked_since >= timeout:
+                effects += self._fail(mission, (f'blocked for {timeout:g} s: '
+                                                + '; '.join(mission.blocked),))
+        return effects
+
+    def _check_heartbeats(self, wall: float) -> list[Effect]:
+        effects = []
+        timeout = self.settings.heartbeat_timeout
+        for name, agent in self.agents.items():
+            silent = wall - agent.heard
+            if agent.offline_since is None and silent > timeout:
+                agent.offline_since, agent.back_since = wall, None
+                if self.mission is not None and name in self.mission.tracker.robots:
+                    self.mission.tracker.mark_offline(name)
+                    effects.append(Note(MissionEventKind.ROBOT_OFFLINE,
+                                        (f'no state for {silent:.1f} s',), robot=name))
+            elif agent.back_since is not None and silent <= timeout \
+                    and wall - agent.back_since >= timeout:
+                agent.offline_since = agent.back_since = None
+                self._mark_offline_as_heard(name)
+                if self.mission is not None and name in self.mission.tracker.robots:
+                    effects.append(Note(MissionEventKind.ROBOT_BACK,
+                                        (f'reporting again ({agent.report.mode})',),
+                                        robot=name))
+        return effects
+
+    def _heard(self, robot: str) -> bool:
+        agent = self.agents.get(robot)
+        return agent is not None and agent.offline_since is None
+
+    def _mark_offline_as_heard(self, robot: str) -> None:
+        """The tracker shows a robot offline for as long as its agent is judged offline,
+        whatever its latest report says."""
+        agent = self.agents.get(robot)
+        mission = self.mission
+        if mission is not None and agent is not None and agent.offline_since is not None \
+                and robot in mission.tracker.robots:
+            mission.tracker.mark_offline(robot)
+
+    # --- solving ---------------------------------------------------------------------------
+
+    def _unavailable(self, mission: _Mission, wall: float) -> dict[str, str]:
+        """Robot -> why it cannot take part in planning now ('' if it can)."""
+        why = {}
+        for robot in mission.problem.robots:
+            agent = self.agents.get(robot.name)
+            if agent is None:
+                why[robot.name] = (f'has not reported since the mission was accepted '
+                                   f'{wall - mission.accepted:.0f} s ago')
+            elif agent.offline_since is not None:
+                why[robot.name] = 'offline (heartbeat lost)'
+            elif agent.report.mode == RobotMode.FAILED:
+                why[robot.name] = 'failed'
+            elif agent.report.refusal:
+                why[robot.name] = f'refuses its plan: {agent.report.refusal}'
+            else:
+                why[robot.name] = ''
+        return why
+
+    def _fleet(self, mission: _Mission, unavailable: dict[str, str]) -> dict:
+        return {name: (self.agents[name].report.incarnation, self.agents[name].report.failures)
+                for name, why in unavailable.items() if not why}
+
+    def _plan(self, mission: _Mission, wall: float) -> list[Effect]:
+        """The first plan of the mission, for the robots available now, from where they are."""
+        unavailable = self._unavailable(mission, wall)
+        fleet = self._fleet(mission, unavailable)
+        problem = mission.problem
+        state = self._initial_state(mission, fleet)
+        if state is None:
+            posed = problem
+        else:
+            residual = residual_problem(problem, state)
+            if residual.blocked:
+                mission.planned = fleet
+                return self._block(mission, wall, tuple(residual.blocked)
+                                   + self._missing(unavailable))
+            posed = residual.problem
+        mission.state = MissionState.PLANNING
+        return [self._solve(mission, 'plan', fleet, (), posed, mission.settings.time_limit)]
+
+    def _initial_state(self, mission: _Mission, fleet) -> ExecutionState | None:
+        """Where the robots are at the mission start, when that is not simply what the
+        scenario says: some robots are out, or the last mission left them somewhere the
+        scenario knows."""
+        problem = mission.problem
+        locations = set(problem.locations())
+        robots, moved = {}, False
+        for robot in problem.robots:
+            agent = self.agents.get(robot.name)
+            at = agent.report.destination or agent.report.location if agent else ''
+            location = robot.start_location
+            if robot.name in fleet and at in locations and at != location:
+                location, moved = at, True
+            robots[robot.name] = RobotState(robot.name, robot.name in fleet, location,
+                                            robot.release_time)
+        if not moved and len(fleet) == len(problem.robots):
+            return None
+        return ExecutionState(Fraction(0), frozenset(), {}, robots)
+
+    def _replan(self, mission: _Mission, wall: float, reasons: tuple[str, ...]
+                ) -> list[Effect]:
+        unavailable = self._unavailable(mission, wall)
+        fleet = self._fleet(mission, unavailable)
+        try:
+            state = mission.tracker.execution_state(self._now(mission, wall))
+        except ValueError as error:
+            mission.planned = fleet
+            return self._block(mission, wall, (f'cannot tell the execution state: {error}',))
+        # The tracker knows failed and offline robots; refusing and silent ones are out too.
+        state = replace(state, robots={name: replace(robot, healthy=name in fleet)
+                                       for name, robot in state.robots.items()})
+        mission.state = MissionState.REPLANNING
+        return [self._solve(mission, 'replan', fleet, reasons, mission.problem,
+                            mission.settings.replan_time_limit, mission.schedule, state)]
+
+    def _solve(self, mission, kind, fleet, reasons, problem, time_limit, previous=None,
+               state=None) -> Solve:
+        self._tokens += 1
+        mission.solving = _Solving(self._tokens, kind, problem, fleet, reasons, state)
+        return Solve(self._tokens, kind, problem, time_limit, previous, state, reasons)
+
+    def solved(self, token: int, outcome, wall: float) -> list[Effect]:
+        """The outcome of `Solve` `token`: a `Result` ('plan'), a `Replan` ('replan'), or
+        the ValueError the solver raised. Outcomes of superseded solves are dropped."""
+        mission = self.mission
+        if mission is None or mission.solving is None or mission.solving.token != token:
+            return []
+        solving, mission.solving = mission.solving, None
+        if mission.state.ended:
+            return []
+        fleet_now = self._fleet(mission, self._unavailable(mission, wall))
+        if solving.kind == 'plan':
+            return self._first_plan(mission, solving, outcome, wall, fleet_now)
+        return self._new_revision(mission, solving, outcome, wall, fleet_now)
+
+    def _first_plan(self, mission, solving, outcome, wall, fleet_now) -> list[Effect]:
+        limit = mission.settings.time_limit
+        if isinstance(outcome, Exception):
+            return self._fail(mission, (f'solver: {outcome}',))
+        result: Result = outcome
+        if result.schedule is None:
+            return self._fail(mission, (f"no plan: solver '{result.solver}' answered "
+                                        f'{result.status} within {limit:g} s',))
+        posed = solving.problem
+        problems = validate(posed, result.schedule)
+        if problems:
+            return self._fail(mission, tuple(f'solver returned an invalid schedule: {p}'
+                                             for p in problems))
+        mission.planned = solving.fleet
+        mission.start = wall + mission.settings.start_delay
+        return self._publish(mission, posed, result, frozenset(), ())
+
+    def _new_revision(self, mission, solving, outcome, wall, fleet_now) -> list[Effect]:
+        tracker = mission.tracker
+        if tracker.complete:
+            return []
+        if fleet_now != solving.fleet:
+            # The fleet changed while solving: this plan would give work to a robot that is
+            # out, or leave out one that is back. The next tick re-plans from the new state.
+            mission.state = MissionState.EXECUTING
+            return [Note(MissionEventKind.WARNING,
+                         ('re-plan discarded: the fleet changed while it was solved',))]
+        mission.planned = solving.fleet
+        if isinstance(outcome, Exception):
+            return self._block(mission, wall, (f're-planning failed: {outcome}',))
+        replanned: Replan = outcome
+        residual = replanned.residual
+        if residual.complete:
+            mission.state = MissionState.EXECUTING
+            return []
+        if residual.blocked:
+            return self._block(mission, wall, tuple(residual.blocked))
+        result = replanned.result
+        if result.schedule is None:
+            return self._block(mission, wall, (
+                f"no plan for what remains: solver '{result.solver}' answered "
+                f'{result.status} within {mission.settings.replan_time_limit:g} s',))
+        if replanned.problems:
+            return self._block(mission, wall, tuple(f're-planned schedule is invalid: {p}'
+                                                    for p in replanned.problems))
+        progressed = self._progressed(mission, solving.state, residual.problem)
+        if progressed:
+            # Restarting these would redo work done meanwhile: plan again from now.
+            mission.state = MissionState.EXECUTING
+            mission.pending = solving.reasons
+            return [Note(MissionEventKind.WARNING,
+                         ('re-plan discarded: ' + ', '.join(progressed)
+                          + ' progressed while it was solved',))]
+        notes = [Note(MissionEventKind.JOB_VOIDED, ('its hold was lost',), job=job)
+                 for job in residual.voided]
+        mission.blocked, mission.blocked_since = (), None
+        return notes + self._publish(mission, residual.problem, result,
+                                     frozenset(residual.problem.fixed), solving.reasons)
+
+    def _progressed(self, mission, posed_state: ExecutionState, posed: Problem) -> list[str]:
+        """Jobs the new plan starts afresh that started or completed since it was posed."""
+        tracker = mission.tracker
+        moved = []
+        for job in posed.jobs:
+            if job.name in posed.fixed:
+                continue
+            record = tracker.jobs[job.name]
+            started_before = job.name in posed_state.running or job.name in posed_state.done
+            if (record.end is not None or record.started) and not started_before:
+                moved.append(f"job '{job.name}'")
+        return moved
+
+    def _publish(self, mission, posed, result, continued, reasons) -> list[Effect]:
+        tracker = mission.tracker
+        revision = tracker.revision + 1
+        tracker.set_plan(result.schedule, revision, continued)
+        mission.schedule = result.schedule
+        mission.planned_makespan = float(result.makespan)
+        mission.replan_reasons = reasons
+        mission.state = MissionState.EXECUTING
+        return [PublishPlan(revision, posed, result, continued, reasons, mission.start),
+                Note(MissionEventKind.PLAN_PUBLISHED, reasons)]
+
+    def _replan_reasons(self, mission: _Mission, wall: float) -> list[str]:
+        """Why the current plan (or blocked verdict) no longer fits the fleet; empty if it
+        does. Late and aborted operations count only while executing: a blocked mission
+        waits for a robot to come back."""
+        reasons = []
+        for name, why in self._unavailable(mission, wall).items():
+            planned = mission.planned.get(name)
+            if planned is not None and why:
+                reasons.append(f"robot '{name}' {why}")
+            elif planned is None and not why:
+                reasons.append(f"robot '{name}' available")
+            elif planned is not None:
+                report = self.agents[name].report
+                if report.incarnation != planned[0]:
+                    reasons.append(f"robot '{name}' restarted: its agent lost its tasks")
+                elif report.failures != planned[1]:
+                    reasons.append(f"robot '{name}' failed and recovered")
+        if mission.state == MissionState.EXECUTING:
+            tracker = mission.tracker
+            reasons += [f"job '{j}' aborted" for j in sorted(tracker.aborted)]
+            reasons += tracker.overruns(mission.settings.delay_threshold)
+        return reasons
+
+    # --- ends ------------------------------------------------------------------------------
+
+    def _block(self, mission, wall, reasons) -> list[Effect]:
+        """Nothing can be planned until the fleet changes; the current plan stays, so the
+        robots finish what they can of it."""
+        mission.state = MissionState.BLOCKED
+        if mission.blocked_since is None:
+            mission.blocked_since = wall
+        effects = []
+        if reasons != mission.blocked:
+            effects.append(Note(MissionEventKind.BLOCKED, reasons))
+        mission.blocked = reasons
+        return effects
+
+    def _missing(self, unavailable) -> tuple[str, ...]:
+        return tuple(f"robot '{name}' {why}" for name, why in unavailable.items() if why)
+
+    def _fail(self, mission, reasons) -> list[Effect]:
+        mission.state = MissionState.FAILED
+        mission.failure = reasons
+        return [Note(MissionEventKind.MISSION_FAILED, reasons)]
+
+    def _complete(self, mission) -> list[Effect]:
+        """Every job reported done: the mission is complete if what was executed is a valid
+        schedule, and failed otherwise."""
+        violations = executed_violations(mission.tracker)
+        if violations:
+            return self._fail(mission, tuple(f'executed timeline: {v}' for v in violations))
+        mission.state = MissionState.COMPLETE
+        executed = float(mission.tracker.projected_makespan(0))
+        return [Note(MissionEventKind.MISSION_COMPLETE,
+                     (f'executed makespan {executed:.2f}, planned '
+                      f'{mission.planned_makespan:.2f}',))]
+
+    # --- views -----------------------------------------------------------------------------
+
+    def _now(self, mission: _Mission, wall: float) -> float:
+        """Schedule time since the mission start (negative before it, 0 without a plan)."""
+        if mission.start is None:
+            return 0.0
+        return (wall - mission.start) / mission.settings.time_scale
+
+    def now_units(self, wall: float) -> float:
+        return 0.0 if self.mission is None else self._now(self.mission, wall)
+
+    def _unknown(self, robot: str) -> str:
+        return (f"agent of robot '{robot}' is running, but scenario "
+                f"'{self.mission.problem.name}' has no such robot")
+
+    def warnings(self, wall: float) -> tuple[str, ...]:
+        mission = self.mission
+        if mission is None:
+            return ()
+        warnings = []
+        for name, why in self._unavailable(mission, wall).items():
+            if why and mission.state != MissionState.WAITING_FOR_ROBOTS:
+                warnings.append(f"robot '{name}' {why}")
+        timeout = self.settings.heartbeat_timeout
+        for name, agent in sorted(self.agents.items()):
+            if name not in mission.tracker.robots and wall - agent.heard <= timeout:
+                warnings.append(self._unknown(name))
+        return tuple(warnings)
+
+    def status(self, wall: float) -> StatusView | None:
+        mission = self.mission
+        if mission is None:
+            return None
+        tracker = mission.tracker
+        now = self._now(mission, wall)
+        blocked = mission.blocked
+        if mission.state == MissionState.WAITING_FOR_ROBOTS:
+            blocked = tuple(f"waiting for robot '{r.name}' to report"
+                            for r in mission.problem.robots if not self._heard(r.name))
+        elif mission.state in (MissionState.FAILED, MissionState.CANCELLED):
+            blocked = mission.failure
+        projected = float(tracker.projected_makespan(now)) if tracker.plan else math.nan
+        return StatusView(
+            mission.id, mission.problem.name, mission.state, tracker.revision,
+            len(tracker.done), len(tracker.running), len(tracker.jobs),
+            mission.planned_makespan, projected, max(now, 0.0), blocked,
+            mission.replan_reasons, self.warnings(wall), Counter(tracker.ignored))
+

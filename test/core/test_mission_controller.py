@@ -1,0 +1,379 @@
+"""The mission controller's decisions, driven by hand-made reports and a fake clock (no ROS).
+
+The paper's instance: its optimum (32) is found in well under a second, so every solve the
+controller asks for is run here for real, through the same functions the node calls.
+"""
+
+from dataclasses import replace
+from pathlib import Path
+
+import pytest
+
+from fjsp_common.vocabulary import EventKind, MissionEventKind, MissionState, RobotMode
+from fjsp_planner.core.mission import (
+    EventReport,
+    JobDone,
+    MissionController,
+    Note,
+    PublishPlan,
+    RobotReport,
+    Settings,
+    Solve,
+)
+from fjsp_planner.core.replan import replan
+from fjsp_planner.core.scenario import load_scenario
+from fjsp_planner.core.solve import solve
+
+SCENARIO = Path(__file__).resolve().parents[2] / 'config' / 'scenarios' / 'solar_panel.yaml'
+ROBOTS = ('Assembler', 'LSMS', 'MARC1', 'MARC2')
+SETTINGS = Settings(time_limit=5.0, replan_time_limit=2.0, heartbeat_timeout=1.0,
+                    robot_wait_timeout=3.0, start_delay=0.0, time_scale=1.0)
+
+
+@pytest.fixture(scope='module')
+def problem():
+    return load_scenario(SCENARIO)
+
+
+class Fleet:
+    """A controller, a clock in wall seconds (= schedule units here) and the effects so far."""
+
+    def __init__(self, problem, settings=SETTINGS):
+        self.problem = problem
+        self.controller = MissionController(settings)
+        self.wall = 1000.0
+        self.effects = []
+        self.failures = dict.fromkeys(ROBOTS, 0)
+        self.incarnations = dict.fromkeys(ROBOTS, 1)
+        self.modes = dict.fromkeys(ROBOTS, RobotMode.IDLE)
+        self.refusals = dict.fromkeys(ROBOTS, '')
+        self.events = 0
+
+    def take(self, effects):
+        self.effects += effects
+        return effects
+
+    def start(self, mission='m1'):
+        return self.take(self.controller.start(self.problem, mission, self.wall))
+
+    def report(self, robot, mode=None, **fields):
+        if mode is not None:
+            self.modes[robot] = mode
+        report = RobotReport(robot, self.modes[robot], incarnation=self.incarnations[robot],
+                             failures=self.failures[robot], refusal=self.refusals[robot],
+                             **fields)
+        return self.take(self.controller.robot_state(report, self.wall))
+
+    def heartbeat(self, robots=ROBOTS):
+        for robot in robots:
+            self.report(robot)
+
+    def tick(self, advance=0.1, robots=ROBOTS):
+        """Advance the clock in heartbeat-sized steps, robots in `robots` reporting."""
+        effects = []
+        steps = max(1, round(advance / 0.1))
+        for _ in range(steps):
+            self.wall += advance / steps
+            self.heartbeat(robots)
+            effects += self.take(self.controller.tick(self.wall))
+        return effects
+
+    def run_solves(self, effects=None):
+        """Carry out the pending solves as the node would; the effects of their outcomes."""
+        out = []
+        for effect in self.effects if effects is None else effects:
+            if not isinstance(effect, Solve):
+                continue
+            if effect.kind == 'plan':
+                outcome = solve(effect.problem, time_limit=effect.time_limit)
+            else:
+                outcome = replan(effect.problem, effect.previous, effect.state,
+                                 time_limit=effect.time_limit)
+            out += self.take(self.controller.solved(effect.token, outcome, self.wall))
+        return out
+
+    def event(self, kind, robot, job, time, mission='m1', revision=None):
+        self.events += 1
+        revision = self.controller.mission.tracker.revision if revision is None else revision
+        effects, why = self.controller.task_event(
+            EventReport(f'{robot}/{self.events}', mission, kind, robot, job, revision, time),
+            self.wall)
+        self.take(effects)
+        return effects, why
+
+    def execute(self, until=None, without=''):
+        """Report the current plan's jobs as executed to plan (those starting before
+        `until`, and not involving robot `without`), in start order."""
+        plan = self.controller.mission.schedule
+        tracker = self.controller.mission.tracker
+        for name, a in sorted(plan.jobs.items(), key=lambda kv: kv[1].start):
+            if until is not None and a.start >= until:
+                break
+            if tracker.jobs[name].end is not None or without in a.robots:
+                continue
+            for robot in a.robots:
+                if robot not in tracker.jobs[name].started:
+                    self.event(EventKind.STARTED, robot, name, float(a.start))
+            for robot, q in a.robots.items():
+                end = a.start + self.problem.duration(robot, q)
+                if until is None or end <= until:
+                    self.event(EventKind.OPERATION_DONE, robot, name, float(end))
+
+    def state(self):
+        return self.controller.mission.state
+
+    def status(self):
+        return self.controller.status(self.wall)
+
+
+def kinds(effects, kind):
+    return [e for e in effects if isinstance(e, kind)]
+
+
+def notes(effects, kind):
+    return [e for e in effects if isinstance(e, Note) and e.kind == kind]
+
+
+def executing(problem, settings=SETTINGS) -> Fleet:
+    """A fleet whose four robots reported, with revision 1 published."""
+    fleet = Fleet(problem, settings)
+    fleet.start()
+    fleet.heartbeat()
+    fleet.tick()
+    fleet.run_solves()
+    assert fleet.state() == MissionState.EXECUTING
+    return fleet
+
+
+def test_first_plan_waits_for_every_robot_then_solves_the_scenario(problem):
+    fleet = Fleet(problem)
+    effects = fleet.start()
+    assert notes(effects, MissionEventKind.MISSION_STARTED)
+    assert fleet.state() == MissionState.WAITING_FOR_ROBOTS
+    assert fleet.status().blocked == ("waiting for robot 'Assembler' to report",
+                                      "waiting for robot 'LSMS' to report",
+                                      "waiting for robot 'MARC1' to report",
+                                      "waiting for robot 'MARC2' to report")
+    fleet.heartbeat(ROBOTS[:3])
+    assert not kinds(fleet.tick(robots=ROBOTS[:3]), Solve)
+    fleet.heartbeat()
+    (request,) = kinds(fleet.tick(), Solve)
+    assert request.kind == 'plan' and request.problem is problem  # nothing moved: as given
+    assert fleet.state() == MissionState.PLANNING
+    (published,) = kinds(fleet.run_solves(), PublishPlan)
+    assert published.revision == 1 and published.result.makespan == 32
+    assert fleet.state() == MissionState.EXECUTING
+
+
+def test_a_robot_that_never_reports_is_planned_without_and_named(problem):
+    fleet = Fleet(problem)
+    fleet.start()
+    fleet.tick(advance=3.5, robots=ROBOTS[:3])
+    (request,) = kinds(fleet.effects, Solve)
+    assert {r.name for r in request.problem.robots} == {'Assembler', 'LSMS', 'MARC1'}
+    fleet.run_solves()
+    assert fleet.state() == MissionState.EXECUTING
+    assert any("robot 'MARC2' has not reported" in w for w in fleet.status().warnings)
+    fleet.report('MARC2')
+    replans = kinds(fleet.tick(), Solve)
+    assert replans and "robot 'MARC2' available" in replans[0].reasons
+
+
+def test_failure_replans_without_the_robot(problem):
+    fleet = executing(problem)
+    fleet.wall += 5
+    fleet.execute(until=5)
+    fleet.failures['MARC1'] += 1
+    effects = fleet.report('MARC1', RobotMode.FAILED)
+    assert notes(effects, MissionEventKind.ROBOT_FAILED)
+    (request,) = kinds(fleet.tick(), Solve)
+    assert request.kind == 'replan' and "robot 'MARC1' failed" in request.reasons
+    assert not request.state.robots['MARC1'].healthy
+    (published,) = kinds(fleet.run_solves(), PublishPlan)
+    assert published.revision == 2 and 'MARC1' not in published.result.schedule.sequences
+
+
+def test_failure_and_recovery_between_two_ticks_still_replans(problem):
+    """The recovered agent dropped its tasks: it must be planned in again, though it looks
+    as healthy as before."""
+    fleet = executing(problem)
+    fleet.failures['MARC1'] += 1
+    fleet.report('MARC1', RobotMode.FAILED)
+    fleet.report('MARC1', RobotMode.IDLE)
+    (request,) = kinds(fleet.tick(), Solve)
+    assert "robot 'MARC1' failed and recovered" in request.reasons
+
+
+def test_a_restarted_agent_is_replanned(problem):
+    fleet = executing(problem)
+    fleet.incarnations['LSMS'] = 2
+    (request,) = kinds(fleet.tick(), Solve)
+    assert "robot 'LSMS' restarted: its agent lost its tasks" in request.reasons
+
+
+def test_a_refusing_agent_is_left_out_and_named(problem):
+    fleet = executing(problem)
+    fleet.refusals['MARC2'] = "plan revision 1 makes 'MARC2' a 'MARC' but this agent plays a " \
+                              "'Gantry'; refusing the plan"
+    effects = fleet.report('MARC2')
+    (warning,) = notes(effects, MissionEventKind.WARNING)
+    assert 'MARC2' in warning.reasons[0] and 'refuses its plan' in warning.reasons[0]
+    (request,) = kinds(fleet.tick(), Solve)
+    assert not request.state.robots['MARC2'].healthy
+    fleet.run_solves()
+    assert fleet.state() == MissionState.EXECUTING
+    assert any('refuses its plan' in w for w in fleet.status().warnings)
+
+
+def test_when_every_robot_refuses_the_mission_is_blocked_naming_them(problem):
+    fleet = Fleet(problem)
+    fleet.start()
+    for robot in ROBOTS:
+        fleet.refusals[robot] = f"plan revision 1 makes '{robot}' a 'X' but this agent plays " \
+                                "a 'Gantry'"
+    fleet.tick(advance=0.2)
+    assert fleet.state() == MissionState.BLOCKED
+    blocked = '\n'.join(fleet.status().blocked)
+    assert "job 'M1' cannot be staffed" in blocked
+    assert "robot 'MARC1' refuses its plan" in blocked
+
+
+def test_unknown_agent_is_a_warning(problem):
+    fleet = executing(problem)
+    effects = fleet.take(fleet.controller.robot_state(RobotReport('R2D2', RobotMode.IDLE),
+                                                      fleet.wall))
+    (warning,) = notes(effects, MissionEventKind.WARNING)
+    assert "'R2D2'" in warning.reasons[0]
+    assert any("agent of robot 'R2D2' is running" in w for w in fleet.status().warnings)
+    # Its heartbeats are one warning, not one per heartbeat.
+    assert not fleet.controller.robot_state(RobotReport('R2D2', RobotMode.IDLE), fleet.wall)
+
+
+def test_heartbeat_loss_then_back_after_a_full_timeout(problem):
+    fleet = executing(problem)
+    effects = fleet.tick(advance=1.5, robots=('Assembler', 'LSMS', 'MARC1'))
+    assert notes(effects, MissionEventKind.ROBOT_OFFLINE)[0].robot == 'MARC2'
+    (request,) = kinds(effects, Solve)
+    assert "robot 'MARC2' offline (heartbeat lost)" in request.reasons
+    fleet.run_solves()
+    # One heartbeat is not enough to count again: it must keep reporting for a timeout.
+    assert not kinds(fleet.tick(), Solve)
+    assert not notes(fleet.tick(advance=0.5), MissionEventKind.ROBOT_BACK)
+    effects = fleet.tick(advance=0.7)
+    assert notes(effects, MissionEventKind.ROBOT_BACK)
+    assert "robot 'MARC2' available" in kinds(effects, Solve)[0].reasons
+
+
+def test_a_starved_executor_does_not_make_robots_offline(problem):
+    fleet = executing(problem)
+    fleet.wall += 2.0  # nothing processed for 2 s, then a tick comes first
+    assert not notes(fleet.take(fleet.controller.tick(fleet.wall)),
+                     MissionEventKind.ROBOT_OFFLINE)
+
+
+def test_executed_mission_completes(problem):
+    fleet = executing(problem)
+    fleet.execute()
+    assert len(kinds(fleet.effects, JobDone)) == 12
+    assert fleet.state() == MissionState.COMPLETE
+    (complete,) = notes(fleet.effects, MissionEventKind.MISSION_COMPLETE)
+    assert 'executed makespan 32.00' in complete.reasons[0]
+
+
+def test_an_invalid_executed_timeline_fails_the_mission(problem):
+    """Jobs reported done in an order that breaks precedence: not a success."""
+    fleet = executing(problem)
+    plan = fleet.controller.mission.schedule
+    for name, a in plan.jobs.items():
+        for robot in a.robots:
+            fleet.event(EventKind.STARTED, robot, name, 0.0)
+            fleet.event(EventKind.OPERATION_DONE, robot, name, 1.0)
+    assert fleet.state() == MissionState.FAILED
+    assert any('executed timeline' in r for r in fleet.status().blocked)
+
+
+def test_events_of_another_mission_are_counted_once_logged(problem):
+    fleet = executing(problem)
+    _, why = fleet.event(EventKind.STARTED, 'MARC1', 'M1', 0.0, mission='old')
+    assert "mission 'old'" in why
+    _, again = fleet.event(EventKind.STARTED, 'MARC1', 'M2', 0.0, mission='old')
+    assert again == ''
+    assert fleet.status().ignored['stale'] == 2
+
+
+def test_a_replan_outdated_by_the_fleet_is_discarded(problem):
+    fleet = executing(problem)
+    fleet.failures['MARC1'] += 1
+    fleet.report('MARC1', RobotMode.FAILED)
+    (request,) = kinds(fleet.tick(), Solve)
+    fleet.report('MARC1', RobotMode.IDLE)  # recovered while the solve ran
+    effects = fleet.run_solves([request])
+    assert not kinds(effects, PublishPlan)
+    assert fleet.state() == MissionState.EXECUTING
+    assert kinds(fleet.tick(), Solve)  # and planned again
+
+
+def test_jobs_done_while_replanning_are_not_redone(problem):
+    fleet = executing(problem)
+    fleet.wall += 2
+    fleet.execute(until=2)
+    # A robot that some job of the next 10 units can do without.
+    window = [a for a in fleet.controller.mission.schedule.jobs.values()
+              if 2 <= a.start and a.end <= 12]
+    out = next(r for r in ROBOTS if any(r not in a.robots for a in window))
+    fleet.failures[out] += 1
+    fleet.report(out, RobotMode.FAILED)
+    (request,) = kinds(fleet.tick(), Solve)
+    # Before the new plan arrives, the other robots finish more jobs of the old one.
+    fleet.execute(until=12, without=out)
+    done = set(fleet.controller.mission.tracker.done)
+    assert done - set(request.state.done)
+    effects = fleet.run_solves([request])
+    assert not kinds(effects, PublishPlan)
+    (warning,) = notes(effects, MissionEventKind.WARNING)
+    assert 'progressed while it was solved' in warning.reasons[0]
+    (again,) = kinds(fleet.tick(), Solve)
+    assert set(again.state.done) >= done
+    assert f"robot '{out}' failed" in again.reasons
+
+
+def test_stale_solve_outcomes_are_dropped(problem):
+    fleet = executing(problem)
+    assert fleet.controller.solved(999, None, fleet.wall) == []
+
+
+def test_cancel_publishes_a_cancelling_revision_and_frees_the_fleet(problem):
+    fleet = executing(problem)
+    with pytest.raises(ValueError, match='one mission per fleet'):
+        fleet.controller.start(problem, 'm2', fleet.wall)
+    effects = fleet.take(fleet.controller.cancel('operator cancelled', fleet.wall))
+    (cancelling,) = kinds(effects, PublishPlan)
+    assert cancelling.cancelled and cancelling.revision == 2
+    assert fleet.state() == MissionState.CANCELLED
+    assert fleet.status().blocked == ('operator cancelled',)
+    with pytest.raises(ValueError, match='no mission is running'):
+        fleet.controller.cancel('again', fleet.wall)
+    fleet.controller.start(problem, 'm2', fleet.wall)
+    assert fleet.controller.mission.id == 'm2'
+
+
+def test_next_mission_starts_where_the_robots_are(problem):
+    fleet = executing(problem)
+    fleet.execute()
+    for robot in ROBOTS:
+        fleet.report(robot, location='Ad')
+    (request,) = kinds(fleet.controller.start(problem, 'm2', fleet.wall), Solve)
+    assert {r.start_location for r in request.problem.robots} == {'Ad'}
+
+
+def test_blocked_for_longer_than_the_timeout_fails(problem):
+    fleet = executing(problem, replace(SETTINGS, blocked_timeout=2.0))
+    for robot in ('MARC1', 'MARC2'):
+        fleet.failures[robot] += 1
+        fleet.report(robot, RobotMode.FAILED)
+    fleet.tick()
+    fleet.run_solves()
+    assert fleet.state() == MissionState.BLOCKED
+    fleet.tick(advance=2.5)
+    assert fleet.state() == MissionState.FAILED
+    assert 'blocked for 2 s' in fleet.status().blocked[0]
