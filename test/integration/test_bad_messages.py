@@ -64,7 +64,8 @@ def test_bad_messages_are_ignored_and_counted(launcher, observer):
     assert f"event '{original.event_id}' was already received" in planner
     assert "unknown robot 'R2D2'" in planner
     assert "unknown job 'Zz'" in planner
-    assert "state of unknown robot 'R2D2'" in planner
+    assert "agent of robot 'R2D2' is running, but scenario 'solar_panel' has no such robot" \
+        in planner
     for robot, _ in ROBOTS:
         assert 'ignoring stale plan revision 0' in launcher.log(f'{robot.lower()}_agent')
         assert observer.robots[robot].plan_revision == 1
