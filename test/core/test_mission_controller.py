@@ -47,6 +47,8 @@ class Fleet:
         self.incarnations = dict.fromkeys(ROBOTS, 1)
         self.modes = dict.fromkeys(ROBOTS, RobotMode.IDLE)
         self.refusals = dict.fromkeys(ROBOTS, '')
+        self.following = {}
+        """Fields every report of the robots repeats, e.g. the mission they follow."""
         self.events = 0
 
     def take(self, effects):
@@ -61,7 +63,7 @@ class Fleet:
             self.modes[robot] = mode
         report = RobotReport(robot, self.modes[robot], incarnation=self.incarnations[robot],
                              failures=self.failures[robot], refusal=self.refusals[robot],
-                             **fields)
+                             **{**self.following, **fields})
         return self.take(self.controller.robot_state(report, self.wall))
 
     def heartbeat(self, robots=ROBOTS):
@@ -377,3 +379,65 @@ def test_blocked_for_longer_than_the_timeout_fails(problem):
     fleet.tick(advance=2.5)
     assert fleet.state() == MissionState.FAILED
     assert 'blocked for 2 s' in fleet.status().blocked[0]
+
+
+def test_jobs_added_mid_mission_are_replanned_in(problem):
+    from fjsp_planner.core.extension import extend
+
+    fleet = executing(problem)
+    fleet.wall += 5
+    fleet.execute(until=5)
+    tracker = fleet.controller.mission.tracker
+    extended, added = extend(problem, 'jobs: [{name: Inspect, location: Ad, plans: '
+                             '[[locomote]]}]\nprecedence: [[Ad, Inspect]]\n',
+                             tracker.done | tracker.running)
+    effects = fleet.take(fleet.controller.add_jobs(extended, added, fleet.wall))
+    assert notes(effects, MissionEventKind.JOBS_ADDED)[0].job == 'Inspect'
+    (request,) = kinds(effects, Solve)
+    assert 'jobs added: Inspect' in request.reasons
+    (published,) = kinds(fleet.run_solves([request]), PublishPlan)
+    assert 'Inspect' in published.result.schedule.jobs
+    fleet.execute()
+    assert fleet.state() == MissionState.COMPLETE
+    assert fleet.status().jobs_total == 13
+
+
+def test_resume_rebuilds_the_mission_and_replans_above_what_robots_follow(problem):
+    from fjsp_planner.core.journal import DoneRecord, PlanRecord
+
+    fleet = executing(problem)
+    first = kinds(fleet.effects, PublishPlan)[0]
+    fleet.wall += 8
+    fleet.execute(until=8)
+    mission = fleet.controller.mission
+    done = [DoneRecord(mission.tracker.jobs[j].done_as, 1) for j in sorted(mission.tracker.done)]
+    records = [PlanRecord(1, first.mission_start, first.result.schedule, frozenset(), ())]
+    # A new planner process: a fresh controller, the journal, and the fleet's reports.
+    restarted = Fleet(problem)
+    restarted.wall = fleet.wall
+    effects = restarted.take(restarted.controller.resume(
+        'm1', problem, SETTINGS, fleet.wall, records + done[:-1], restarted.wall))
+    assert 'resumed after a planner restart' in \
+        notes(effects, MissionEventKind.MISSION_STARTED)[0].reasons[0]
+    restarted.following = {'mission_id': 'm1', 'revision': 3}  # what the robots follow
+    restarted.heartbeat()
+    # The agents' event histories bring back the job whose done record was lost.
+    last = done[-1].assignment
+    for robot, q in last.robots.items():
+        restarted.event(EventKind.STARTED, robot, last.job, float(last.start), revision=1)
+        restarted.event(EventKind.OPERATION_DONE, robot, last.job,
+                        float(last.start + problem.duration(robot, q)), revision=1)
+    assert restarted.controller.mission.tracker.done == mission.tracker.done
+    requests = []
+    for _ in range(20):
+        requests += kinds(restarted.tick(), Solve)
+        if requests:
+            break
+    (request,) = requests
+    assert len(request.reasons) == 1 and 'planner restarted' in request.reasons[0]
+    assert set(request.state.done) == set(mission.tracker.done)
+    (published,) = kinds(restarted.run_solves([request]), PublishPlan)
+    assert published.revision == 4
+    # Done jobs are not redone (a done jig job may go on, continued, while its hold lasts).
+    restarted_jobs = set(published.result.schedule.jobs) - published.continued
+    assert not restarted_jobs & set(mission.tracker.done)

@@ -22,11 +22,16 @@ from dataclasses import dataclass, field, replace
 from fractions import Fraction
 
 from fjsp_common.vocabulary import EventKind, MissionEventKind, MissionState, RobotMode
+from fjsp_planner.core.journal import DoneRecord, PlanRecord, Record
 from fjsp_planner.core.problem import Problem
 from fjsp_planner.core.replan import ExecutionState, Replan, RobotState, residual_problem
-from fjsp_planner.core.schedule import Result, Schedule
+from fjsp_planner.core.schedule import JobAssignment, Result, Schedule
 from fjsp_planner.core.tracking import Ignored, MissionTracker
 from fjsp_planner.core.validate import validate
+
+CATCH_UP = 0.5
+"""Seconds a resumed mission waits, once every robot's event writer is matched, for their
+histories to arrive before it re-plans."""
 
 STARVED = 0.25
 """Seconds between two ticks beyond which the node could not take messages for a while: the
@@ -126,6 +131,8 @@ class JobDone:
     job: str
     time: float
     revision: int
+    assignment: JobAssignment
+    """How it was done: its plan, robots and actual times."""
 
 
 @dataclass(frozen=True)
@@ -157,6 +164,8 @@ class StatusView:
     replan_reasons: tuple[str, ...]
     warnings: tuple[str, ...]
     ignored: Counter
+    blocked_too_long: bool
+    """The mission failed because it stayed blocked beyond its `blocked_timeout`."""
 
 
 # --- what the controller keeps ---------------------------------------------------------
@@ -209,7 +218,11 @@ class _Mission:
     """Other missions whose events arrived: each is logged once."""
     warned: set[str] = field(default_factory=set)
     pending: tuple[str, ...] = ()
-    """Reasons of a re-plan that was discarded: the next tick plans again."""
+    """Reasons of a re-plan still to make (one discarded, jobs added, a restart)."""
+    blocked_too_long: bool = False
+    resumed: bool = False
+    """Rebuilt after a planner restart: re-planned once the fleet has caught it up."""
+    caught_up_since: float | None = None
 
 
 class MissionController:
@@ -246,11 +259,76 @@ class MissionController:
         mission.failure = (reason,)
         effects: list[Effect] = [Note(MissionEventKind.MISSION_CANCELLED, (reason,))]
         if mission.start is not None:
-            revision = mission.tracker.revision + 1
+            revision = self._next_revision(mission)
             mission.tracker.revision = revision
             effects.insert(0, PublishPlan(revision, mission.problem, None, frozenset(),
                                           (reason,), mission.start, cancelled=True))
         return effects
+
+    def add_jobs(self, problem: Problem, jobs: tuple[str, ...], wall: float) -> list[Effect]:
+        """The running mission grows to `problem`, which adds `jobs` (checked by
+        `core.extension.extend`); they are planned in like any re-plan."""
+        mission = self.mission
+        if mission is None or mission.state.ended:
+            raise ValueError('no mission is running')
+        mission.problem = problem
+        mission.tracker.extend(problem)
+        reason = 'jobs added: ' + ', '.join(jobs)
+        effects: list[Effect] = [Note(MissionEventKind.JOBS_ADDED, (reason,),
+                                      job=', '.join(jobs))]
+        if mission.solving is not None:
+            # Whatever is being solved leaves the new jobs out.
+            mission.solving = None
+            mission.state = (MissionState.WAITING_FOR_ROBOTS if mission.schedule is None
+                             else MissionState.EXECUTING)
+        if mission.schedule is not None:
+            mission.pending += (reason,)
+        return effects + self.tick(wall)
+
+    def resume(self, mission_id: str, problem: Problem, settings: Settings, accepted: float,
+               records: list[Record], wall: float) -> list[Effect]:
+        """Rebuild a mission a previous planner process ran, from its journal's plan and
+        done records; it is re-planned from where the robots are once every robot has
+        reported and its event history has arrived (or the robot wait is over)."""
+        if self.mission is not None and not self.mission.state.ended:
+            raise ValueError(f"mission '{self.mission.id}' is {self.mission.state}")
+        mission = _Mission(mission_id, problem, settings, MissionTracker(problem), wall,
+                           resumed=True)
+        tracker = mission.tracker
+        for record in records:
+            if isinstance(record, PlanRecord) and record.schedule is not None:
+                tracker.set_plan(record.schedule, record.revision, record.continued)
+                mission.schedule, mission.start = record.schedule, record.start
+                mission.planned_makespan = float(record.schedule.makespan)
+                mission.replan_reasons = record.reasons
+            elif isinstance(record, DoneRecord):
+                tracker.restore_done(record.assignment)
+        self.mission = mission
+        where = (f'at plan revision {tracker.revision}, {len(tracker.done)}/'
+                 f'{len(tracker.jobs)} jobs done' if mission.schedule is not None
+                 else 'before its first plan')
+        return [Note(MissionEventKind.MISSION_STARTED,
+                     (f'resumed after a planner restart {where}',))] + self.tick(wall)
+
+    def _resume_when_caught_up(self, mission, wall, publishers) -> list[Effect]:
+        if mission.schedule is None:
+            mission.resumed = False
+            return self._plan(mission, wall)
+        heard = sum(self._heard(r.name) for r in mission.problem.robots)
+        waited = wall - mission.accepted
+        if publishers is not None and publishers < heard \
+                and waited < mission.settings.robot_wait_timeout:
+            return []
+        if mission.caught_up_since is None:
+            mission.caught_up_since = wall
+        if wall - mission.caught_up_since < CATCH_UP:
+            return []
+        mission.resumed = False
+        mission.planned = self._fleet(mission, self._unavailable(mission, wall))
+        mission.state = MissionState.EXECUTING
+        mission.pending = ('planner restarted: what remains is re-planned from where the '
+                           'robots are',)
+        return []
 
     # --- what the fleet reports ----------------------------------------------------------
 
@@ -316,16 +394,19 @@ class MissionController:
                                 (f"robot '{event.robot}' aborted it",), job=event.job))
         if outcome.job_done is not None:
             job, end = outcome.job_done
-            effects.append(JobDone(job, end, tracker.revision))
+            effects.append(JobDone(job, end, tracker.revision, tracker.jobs[job].done_as))
             if tracker.complete and not mission.state.ended:
                 effects += self._complete(mission)
         return effects, ''
 
     # --- time passing --------------------------------------------------------------------
 
-    def tick(self, wall: float, subscribers: int | None = None) -> list[Effect]:
+    def tick(self, wall: float, subscribers: int | None = None,
+             publishers: int | None = None) -> list[Effect]:
         """Judge heartbeats, start what is due. `subscribers` counts the plan topic's
-        matched readers: the first plan waits until every robot can hear it."""
+        matched readers: the first plan waits until every robot can hear it. `publishers`
+        counts the task-event writers: a resumed mission waits until it has heard every
+        robot's event history."""
         starved = self._last_tick is not None and wall - self._last_tick > STARVED
         self._last_tick = wall
         effects: list[Effect] = []
@@ -340,7 +421,9 @@ class MissionController:
             unmatched = subscribers is not None and subscribers < len(mission.problem.robots)
             if (not heard or unmatched) and waited < mission.settings.robot_wait_timeout:
                 return effects
-            return effects + self._plan(mission, wall)
+            if not mission.resumed:
+                return effects + self._plan(mission, wall)
+            return effects + self._resume_when_caught_up(mission, wall, publishers)
         if mission.state in (MissionState.EXECUTING, MissionState.BLOCKED):
             reasons = self._replan_reasons(mission, wall)
             if mission.pending:
@@ -353,6 +436,7 @@ class MissionController:
             timeout = mission.settings.blocked_timeout
             if mission.state == MissionState.BLOCKED and timeout > 0 \
                     and wall - mission.blocked_since >= timeout:
+                mission.blocked_too_long = True
                 effects += self._fail(mission, (f'blocked for {timeout:g} s: '
                                                 + '; '.join(mission.blocked),))
         return effects
@@ -562,7 +646,7 @@ class MissionController:
 
     def _publish(self, mission, posed, result, continued, reasons) -> list[Effect]:
         tracker = mission.tracker
-        revision = tracker.revision + 1
+        revision = self._next_revision(mission)
         tracker.set_plan(result.schedule, revision, continued)
         mission.schedule = result.schedule
         mission.planned_makespan = float(result.makespan)
@@ -570,6 +654,12 @@ class MissionController:
         mission.state = MissionState.EXECUTING
         return [PublishPlan(revision, posed, result, continued, reasons, mission.start),
                 Note(MissionEventKind.PLAN_PUBLISHED, reasons)]
+
+    def _next_revision(self, mission: _Mission) -> int:
+        """Above any revision a robot follows: after a restart, the journal may lag them."""
+        followed = [a.report.revision for a in self.agents.values()
+                    if a.report.mission_id == mission.id]
+        return max([mission.tracker.revision, *followed]) + 1
 
     def _replan_reasons(self, mission: _Mission, wall: float) -> list[str]:
         """Why the current plan (or blocked verdict) no longer fits the fleet; empty if it
@@ -674,5 +764,6 @@ class MissionController:
             mission.id, mission.problem.name, mission.state, tracker.revision,
             len(tracker.done), len(tracker.running), len(tracker.jobs),
             mission.planned_makespan, projected, max(now, 0.0), blocked,
-            mission.replan_reasons, self.warnings(wall), Counter(tracker.ignored))
+            mission.replan_reasons, self.warnings(wall), Counter(tracker.ignored),
+            mission.blocked_too_long)
 

@@ -296,3 +296,50 @@ def _distances(read, section):
             distances[key] = value
     return distances
 
+
+
+def scenario_from_text(text: str, name: str = 'mission', panels: int | None = None,
+                       shift=None) -> Problem:
+    """A scenario given as YAML text (e.g. in a mission goal), as `load_scenario` reads files;
+    `name` names it when the text has no `name` of its own."""
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as error:
+        mark = getattr(error, 'problem_mark', None)
+        where = f'line {mark.line + 1}, column {mark.column + 1}' if mark else 'unknown place'
+        reason = getattr(error, 'problem', None) or str(error)
+        raise ScenarioError([f'YAML syntax error at {where}: {reason}']) from None
+    problem, file_panels = _from_mapping(data, default_name=name)
+    count = panels if panels is not None else file_panels['count']
+    distance = _number(shift, 'shift') if shift is not None else file_panels['shift']
+    if count < 1:
+        raise ScenarioError([f'panels must be at least 1, got {count}'])
+    if distance < 0:
+        raise ScenarioError([f'shift must not be negative, got {distance}'])
+    return repeat_panels(problem, count, distance)
+
+
+def problem_mapping(problem: Problem) -> dict:
+    """`problem` as a scenario mapping (the YAML format's sections), exact numbers as
+    'a/b' strings: what `parse_scenario` reads back into the same problem."""
+    def number(value: Fraction) -> str:
+        return str(value)
+
+    return {
+        'name': problem.name,
+        'operation_types': dict(problem.operation_types),
+        **({'locomote': problem.locomote} if problem.locomote is not None else {}),
+        'robot_types': {name: {q: number(t) for q, t in times.items()}
+                        for name, times in problem.robot_types.items()},
+        'robots': [{'name': r.name, 'type': r.type, 'speed': number(r.speed),
+                    **({'start_location': r.start_location} if r.start_location else {}),
+                    'release_time': number(r.release_time)} for r in problem.robots],
+        'jobs': [{'name': j.name, 'location': j.location, 'plans': [list(p) for p in j.plans]}
+                 for j in problem.jobs],
+        'distances': {'pairs': [[a, b, number(d)] for (a, b), d in problem.distances.items()
+                                if a < b]},
+        'precedence': [list(arc) for arc in problem.precedence],
+        'holding': [list(arc) for arc in problem.holding],
+        'time_overrides': [{'robot': r, 'operation': q, 'time': number(t)}
+                           for (r, q), t in problem.time_overrides.items()],
+    }

@@ -109,6 +109,19 @@ class MissionTracker:
                 self.jobs[name] = JobRecord(name, since_revision=revision)
         self.plan, self.revision = schedule, revision
 
+    def extend(self, problem: Problem) -> None:
+        """The mission grew to `problem` (jobs added): its new jobs are tracked too."""
+        self.problem = problem
+        for job in problem.jobs:
+            self.jobs.setdefault(job.name, JobRecord(job.name, since_revision=self.revision))
+
+    def restore_done(self, assignment: JobAssignment) -> None:
+        """A job declared done before the planner restarted, as its journal kept it."""
+        record = self.jobs[assignment.job]
+        record.started = dict.fromkeys(assignment.robots, float(assignment.start))
+        record.operation_done = dict.fromkeys(assignment.robots, float(assignment.end))
+        record.end, record.aborted, record.done_as = float(assignment.end), False, assignment
+
     # --- reports -----------------------------------------------------------------------
 
     def record_event(self, event_id: str, kind: EventKind, robot: str, job: str,
