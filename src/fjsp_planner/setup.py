@@ -25,6 +25,7 @@ setup(
             'planner_node = fjsp_planner.nodes.planner:main',
             'monitor_node = fjsp_planner.nodes.monitor:main',
             'inject_fault = fjsp_planner.faults:main',
+            'mission = fjsp_planner.missions:main',
         ],
     },
 )

@@ -18,6 +18,9 @@ MISSION_EVENTS_TOPIC = 'mission_events'
 MISSION_STATUS_TOPIC = 'mission_status'
 INJECT_FAULT_SERVICE = 'inject_fault'
 """Served by each agent under its robot name: `<robot>/inject_fault`."""
+RUN_MISSION_ACTION = 'run_mission'
+ADD_JOBS_SERVICE = 'add_jobs'
+CANCEL_MISSION_SERVICE = 'cancel_mission'
 
 MAX_FLEET = 128
 """Robot states a late joiner catches up on: at least the largest fleet a scenario may have."""

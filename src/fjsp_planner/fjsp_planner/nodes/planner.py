@@ -7,17 +7,22 @@ story on `mission_events`, its summary on `mission_status` and per-job states on
 (see docs/ros-interfaces.md).
 """
 
+import hashlib
+import math
 import secrets
 import sys
 from concurrent.futures import Future, ThreadPoolExecutor
 from datetime import UTC, datetime
 from pathlib import Path
 
-from ament_index_python.packages import PackageNotFoundError, get_package_share_directory
+from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.node import Node
+from rclpy.task import Future as RosFuture
 from rclpy.time import Time
 
 from fjsp_common.contract import (
+    ADD_JOBS_SERVICE,
+    CANCEL_MISSION_SERVICE,
     EVENT_FROM_MSG,
     EVENTS_QOS,
     JOB_STATES_TOPIC,
@@ -29,12 +34,26 @@ from fjsp_common.contract import (
     PLAN_TOPIC,
     ROBOT_STATES_QOS,
     ROBOT_STATES_TOPIC,
+    RUN_MISSION_ACTION,
     STATE_TO_MSG,
     TASK_EVENTS_TOPIC,
 )
 from fjsp_common.running import ParameterError, declare, run_node, shorten
-from fjsp_common.vocabulary import EventKind, MissionEventKind
+from fjsp_common.vocabulary import EventKind, MissionEventKind, MissionState
+from fjsp_msgs.action import RunMission
 from fjsp_msgs.msg import JobStates, MissionEvent, MissionStatus, Plan, RobotState, TaskEvent
+from fjsp_msgs.srv import AddJobs, CancelMission
+from fjsp_planner.core.extension import extend
+from fjsp_planner.core.journal import (
+    DoneRecord,
+    EndRecord,
+    JobsAddedRecord,
+    Journal,
+    MissionRecord,
+    PlanRecord,
+    journal_path,
+    journals,
+)
 from fjsp_planner.core.mission import (
     EventReport,
     JobDone,
@@ -47,7 +66,7 @@ from fjsp_planner.core.mission import (
 )
 from fjsp_planner.core.problem import ProblemError
 from fjsp_planner.core.replan import replan
-from fjsp_planner.core.scenario import load_scenario
+from fjsp_planner.core.scenario import load_scenario, scenario_from_text
 from fjsp_planner.core.solve import SOLVERS, solve
 from fjsp_planner.core.tracking import Ignored
 from fjsp_planner.nodes.conversions import cancel_msg, job_states, plan_msg
@@ -64,13 +83,26 @@ def new_mission_id(scenario: str) -> str:
     return f'{name}-{stamp}-{secrets.token_hex(2)}'
 
 
-def default_scenario() -> str:
-    try:
-        share = get_package_share_directory('fjsp_planner')
-    except PackageNotFoundError:
-        raise ParameterError("parameter 'scenario' not given and package 'fjsp_planner' "
-                             'is not installed; pass -p scenario:=<path>') from None
-    return str(Path(share) / 'scenarios' / 'solar_panel.yaml')
+ENDINGS = {
+    MissionEventKind.MISSION_COMPLETE: MissionState.COMPLETE,
+    MissionEventKind.MISSION_CANCELLED: MissionState.CANCELLED,
+    MissionEventKind.MISSION_FAILED: MissionState.FAILED,
+}
+
+
+def origin_of(text: str, panels: int, shift: float) -> str:
+    """What identifies a mission given by the `scenario` parameter across restarts."""
+    digest = hashlib.sha256(f'{panels}/{shift}/{text}'.encode()).hexdigest()[:16]
+    return f'parameter:{digest}'
+
+
+class Goal:
+    """A RunMission goal whose mission runs: answered when the mission ends."""
+
+    def __init__(self, handle, mission_id: str):
+        self.handle = handle
+        self.mission_id = mission_id
+        self.ended = RosFuture()
 
 
 SUBJECTS = {
@@ -96,8 +128,8 @@ class PlannerNode(Node):
     def __init__(self):
         super().__init__('planner')
         scenario = declare(self, 'scenario', '',
-                           'scenario file of the mission to run at start-up') \
-            or default_scenario()
+                           'scenario file of a mission to run at start-up; empty: wait for '
+                           'RunMission goals')
         panels = declare(self, 'panels', 0, "panels of the scenario's job set; 0: the file's",
                          low=0, high=50)
         shift = declare(self, 'shift', -1.0,
@@ -130,14 +162,25 @@ class PlannerNode(Node):
         status_period = declare(self, 'status_period', 0.5,
                                 'seconds between periodic status publications', low=0.01,
                                 high=60.0)
-        try:
-            problem = load_scenario(scenario, panels=panels or None,
-                                    shift=shift if shift >= 0 else None)
-        except ProblemError as error:
-            raise ParameterError(f"parameter 'scenario': cannot use '{scenario}':\n"
-                                 + '\n'.join(error.problems)) from None
+        journal_dir = declare(self, 'journal_dir', '',
+                              'directory of the mission journals that let a restarted planner '
+                              'resume its mission; empty: no journal')
+        self.journal_dir = Path(journal_dir).expanduser() if journal_dir else None
+        problem = None
+        if scenario:
+            try:
+                problem = load_scenario(scenario, panels=panels or None,
+                                        shift=shift if shift >= 0 else None)
+                text = Path(scenario).read_text()
+            except (ProblemError, OSError, UnicodeDecodeError) as error:
+                problems = getattr(error, 'problems', [str(error)])
+                raise ParameterError(f"parameter 'scenario': cannot use '{scenario}':\n"
+                                     + '\n'.join(problems)) from None
+            origin = origin_of(text, panels, shift)
 
         self.controller = MissionController(self.settings())
+        self.journal: Journal | None = None
+        self.goal: Goal | None = None
         self.job_done_ids: set[str] = set()
         self.last_published = None
         """(mission, revision, stamp) of this node's latest plan, which it hears back."""
@@ -155,15 +198,33 @@ class PlannerNode(Node):
         self.story_pub = self.create_publisher(MissionEvent, MISSION_EVENTS_TOPIC, EVENTS_QOS)
         self.create_subscription(RobotState, ROBOT_STATES_TOPIC, self.on_robot_state,
                                  ROBOT_STATES_QOS)
-        self.create_subscription(TaskEvent, TASK_EVENTS_TOPIC, self.on_event, EVENTS_QOS)
+        self.events_sub = self.create_subscription(TaskEvent, TASK_EVENTS_TOPIC, self.on_event,
+                                                   EVENTS_QOS)
         self.create_subscription(Plan, PLAN_TOPIC, self.on_plan, LATCHED_QOS)
         self.create_timer(0.1, self.tick)
         self.create_timer(status_period, self.publish_periodic)
+        ActionServer(self, RunMission, RUN_MISSION_ACTION, self.execute_goal,
+                     goal_callback=lambda _: GoalResponse.ACCEPT,
+                     cancel_callback=self.cancel_goal)
+        self.create_service(AddJobs, ADD_JOBS_SERVICE, self.on_add_jobs)
+        self.create_service(CancelMission, CANCEL_MISSION_SERVICE, self.on_cancel)
 
-        log = self.get_logger()
-        log.info(f"scenario '{problem.name}' from {scenario}: {len(problem.jobs)} jobs, "
-                 'robots ' + ', '.join(r.name for r in problem.robots))
-        self.start_mission(problem)
+        resumed = self.resume_unfinished()
+        if problem is None:
+            if not resumed:
+                self.get_logger().info('no scenario given: waiting for RunMission goals')
+        elif resumed == origin or self.ran_before(origin):
+            self.get_logger().info(f"not starting '{scenario}' again: its mission is in the "
+                                   'journal (resumed or ended)')
+        elif resumed:
+            self.get_logger().warning(f"not starting '{scenario}': the resumed mission "
+                                      'runs on this fleet')
+        else:
+            self.get_logger().info(f"scenario '{problem.name}' from {scenario}: "
+                                   f'{len(problem.jobs)} jobs, robots '
+                                   + ', '.join(r.name for r in problem.robots))
+            self.start_mission(problem, text, problem.name, panels, shift, origin,
+                               self.settings())
 
     # --- parameters and time -------------------------------------------------------------
 
@@ -181,17 +242,198 @@ class PlannerNode(Node):
 
     # --- missions --------------------------------------------------------------------------
 
-    def start_mission(self, problem) -> None:
+    def start_mission(self, problem, text, name, panels, shift, origin, settings) -> str:
+        """Start a mission (ValueError while another one runs); its id."""
         mission_id = new_mission_id(problem.name)
+        effects = self.controller.start(problem, mission_id, self.wall(), settings)
+        if self.journal_dir is not None:
+            self.journal = Journal(journal_path(self.journal_dir, mission_id))
+            self.journal.write(MissionRecord(
+                mission_id, text, name, panels, shift, origin, settings.__dict__, self.wall()))
         self.get_logger().info(f"mission '{mission_id}' accepted")
-        self.carry_out(self.controller.start(problem, mission_id, self.wall(),
-                                             self.settings()))
+        self.carry_out(effects)
+        return mission_id
+
+    def resume_unfinished(self) -> str:
+        """Resume the newest mission a previous planner left unfinished; its origin ('' if
+        none). Older unfinished ones are closed as abandoned."""
+        if self.journal_dir is None:
+            return ''
+        unfinished = [(path, records) for path, records in journals(self.journal_dir)
+                      if not isinstance(records[-1], EndRecord)]
+        if not unfinished:
+            return ''
+        log = self.get_logger()
+        for path, _ in unfinished[:-1]:
+            with_end = Journal(path)
+            with_end.write(EndRecord('failed', ('abandoned: a newer mission was resumed',)))
+            with_end.close()
+        path, records = unfinished[-1]
+        head: MissionRecord = records[0]
+        try:
+            problem = scenario_from_text(head.scenario_yaml, head.scenario_name,
+                                         head.panels or None,
+                                         head.shift if head.shift >= 0 else None)
+            for record in records:
+                if isinstance(record, JobsAddedRecord):
+                    problem, _ = extend(problem, record.fragment_yaml)
+        except ProblemError as error:
+            log.error(f'cannot resume the mission of {path}: ' + '; '.join(error.problems))
+            return ''
+        settings = Settings(**{**self.settings().__dict__, **head.settings})
+        self.journal = Journal(path)
+        log.warning(f"resuming mission '{head.mission_id}' from {path}")
+        self.carry_out(self.controller.resume(head.mission_id, problem, settings,
+                                              head.accepted, records[1:], self.wall()))
+        return head.origin
+
+    def ran_before(self, origin: str) -> bool:
+        return self.journal_dir is not None and any(
+            records[0].origin == origin for _, records in journals(self.journal_dir))
+
+    # --- missions as a service -----------------------------------------------------------
+
+    async def execute_goal(self, handle):
+        goal = handle.request
+        try:
+            problem, text, name = self.problem_of(goal)
+        except ProblemError as error:
+            return self.reject(handle, error.problems)
+        defaults = self.settings()
+        settings = Settings(**{**defaults.__dict__, **{
+            key: value for key, value in (
+                ('time_limit', goal.time_limit), ('replan_time_limit', goal.replan_time_limit),
+                ('time_scale', goal.time_scale), ('blocked_timeout', goal.blocked_timeout))
+            if value > 0}})
+        try:
+            mission_id = self.start_mission(problem, text, name, goal.panels, goal.shift,
+                                            f'goal:{bytes(handle.goal_id.uuid).hex()}',
+                                            settings)
+        except ValueError as error:
+            return self.reject(handle, [str(error)])
+        self.goal = Goal(handle, mission_id)
+        self.publish_feedback()
+        state = await self.goal.ended
+        return self.finish_goal(state)
+
+    def problem_of(self, goal):
+        """The goal's scenario: (problem, YAML text, name); ProblemError if it has problems."""
+        if bool(goal.scenario_path) == bool(goal.scenario_yaml):
+            raise ProblemError(['give exactly one of scenario_path and scenario_yaml'])
+        problems = []
+        if not math.isfinite(goal.shift):
+            problems.append(f'shift must be a finite number, got {goal.shift}')
+        for key in ('time_limit', 'replan_time_limit', 'time_scale', 'blocked_timeout'):
+            value = getattr(goal, key)
+            if not (math.isfinite(value) and value >= 0):
+                problems.append(f"{key} must be a finite number >= 0 (0: the planner's "
+                                f'default), got {value}')
+        if goal.panels > 50:
+            problems.append(f'panels must be at most 50, got {goal.panels}')
+        if problems:
+            raise ProblemError(problems)
+        panels = goal.panels or None
+        shift = goal.shift if goal.shift >= 0 else None
+        if goal.scenario_path:
+            path = Path(goal.scenario_path)
+            problem = load_scenario(path, panels=panels, shift=shift)
+            return problem, path.read_text(), path.stem
+        name = goal.scenario_name or 'mission'
+        problem = scenario_from_text(goal.scenario_yaml, name, panels, shift)
+        return problem, goal.scenario_yaml, name
+
+    def reject(self, handle, reasons) -> RunMission.Result:
+        self.get_logger().warning('RunMission goal rejected: '
+                                  + shorten('; '.join(reasons), 2000))
+        handle.abort()
+        return RunMission.Result(state=RunMission.Result.STATE_REJECTED,
+                                 makespan=math.nan, planned_makespan=math.nan,
+                                 reasons=list(reasons))
+
+    def finish_goal(self, state: MissionState) -> RunMission.Result:
+        goal, self.goal = self.goal, None
+        view = self.controller.status(self.wall())
+        complete = state == MissionState.COMPLETE
+        if complete:
+            goal.handle.succeed()
+            code = RunMission.Result.STATE_COMPLETE
+        elif state == MissionState.CANCELLED:
+            if goal.handle.is_cancel_requested:
+                goal.handle.canceled()
+            else:
+                goal.handle.abort()
+            code = RunMission.Result.STATE_CANCELLED
+        else:
+            goal.handle.abort()
+            code = (RunMission.Result.STATE_BLOCKED_TIMEOUT if view.blocked_too_long
+                    else RunMission.Result.STATE_FAILED)
+        return RunMission.Result(
+            mission_id=goal.mission_id, state=code,
+            makespan=view.projected_makespan if complete else math.nan,
+            planned_makespan=view.planned_makespan, revisions=view.revision,
+            jobs_done=view.jobs_done, jobs_total=view.jobs_total,
+            reasons=list(view.blocked) if not complete else
+            [f'executed makespan {view.projected_makespan:.2f}, planned '
+             f'{view.planned_makespan:.2f}'])
+
+    def cancel_goal(self, handle) -> CancelResponse:
+        if self.goal is None or self.goal.handle.goal_id != handle.goal_id:
+            return CancelResponse.REJECT
+        self.carry_out(self.controller.cancel('cancelled by the RunMission client',
+                                              self.wall()))
+        return CancelResponse.ACCEPT
+
+    def on_cancel(self, request, response):
+        mission = self.controller.mission
+        if request.mission_id and (mission is None or request.mission_id != mission.id):
+            response.success = False
+            response.message = (f"no mission '{shorten(request.mission_id, 80)}' runs"
+                                + (f" (running: '{mission.id}')" if mission is not None
+                                   and not mission.state.ended else ''))
+            return response
+        try:
+            effects = self.controller.cancel(shorten(request.reason, 500) or 'cancelled',
+                                             self.wall())
+        except ValueError as error:
+            response.success, response.message = False, str(error)
+            return response
+        self.carry_out(effects)
+        response.success, response.message = True, f"mission '{mission.id}' cancelled"
+        return response
+
+    def on_add_jobs(self, request, response):
+        mission = self.controller.mission
+        response.success = False
+        if mission is None or mission.state.ended:
+            response.message = 'no mission is running'
+            return response
+        if request.mission_id and request.mission_id != mission.id:
+            response.message = (f"mission '{shorten(request.mission_id, 80)}' is not the "
+                                f"running mission '{mission.id}'")
+            return response
+        tracker = mission.tracker
+        try:
+            problem, jobs = extend(mission.problem, request.fragment_yaml,
+                                   tracker.done | tracker.running)
+        except ProblemError as error:
+            response.message = f'{len(error.problems)} problem(s); the mission is unchanged'
+            response.problems = [shorten(p, 500) for p in error.problems]
+            return response
+        if self.journal is not None:
+            self.journal.write(JobsAddedRecord(request.fragment_yaml, jobs))
+        self.carry_out(self.controller.add_jobs(problem, jobs, self.wall()))
+        response.success, response.jobs = True, list(jobs)
+        response.message = f"{len(jobs)} job(s) added to mission '{mission.id}'"
+        return response
 
     # --- inputs ------------------------------------------------------------------------------
 
     def tick(self) -> None:
         self.controller.settings = self.settings()
-        self.carry_out(self.controller.tick(self.wall(), self.plan_pub.get_subscription_count()))
+        if self.journal is not None:
+            self.journal.sync()
+        self.carry_out(self.controller.tick(self.wall(), self.plan_pub.get_subscription_count(),
+                                            self.events_sub.get_publisher_count()))
 
     def on_robot_state(self, msg: RobotState) -> None:
         mode = MODE_FROM_MSG.get(msg.mode)
@@ -285,11 +527,27 @@ class PlannerNode(Node):
                 self.publish_job_done(effect)
             elif isinstance(effect, Note):
                 self.tell(effect)
+                if effect.kind in ENDINGS:
+                    self.end(ENDINGS[effect.kind], effect.reasons)
         self.publish_jobs()
         self.publish_status()
 
+    def end(self, state: MissionState, reasons) -> None:
+        if self.journal is not None:
+            self.journal.write(EndRecord(str(state), tuple(reasons)))
+            self.journal.close()
+            self.journal = None
+        if self.goal is not None and not self.goal.ended.done():
+            self.goal.ended.set_result(state)
+
     def publish_plan(self, effect: PublishPlan) -> None:
         mission = self.controller.mission
+        if self.journal is not None:
+            # On disk before any robot can follow it.
+            self.journal.write(PlanRecord(
+                effect.revision, effect.mission_start,
+                None if effect.cancelled else effect.result.schedule, effect.continued,
+                effect.reasons))
         stamp = self.get_clock().now().to_msg()
         start = Time(nanoseconds=int(effect.mission_start * 1e9)).to_msg()
         if effect.cancelled:
@@ -319,6 +577,10 @@ class PlannerNode(Node):
 
     def publish_job_done(self, effect: JobDone) -> None:
         mission = self.controller.mission
+        if self.journal is not None:
+            # Flushed by the tick: a done job lost in a crash is rebuilt from the agents'
+            # event histories.
+            self.journal.write(DoneRecord(effect.assignment, effect.revision), sync=False)
         self.event_count += 1
         event_id = f'planner/{self.incarnation}/{self.event_count}'
         self.job_done_ids.add(event_id)
@@ -355,10 +617,23 @@ class PlannerNode(Node):
                                         plan_revision=mission.tracker.revision,
                                         jobs=job_states(mission.tracker)))
 
+    def publish_feedback(self) -> None:
+        view = self.controller.status(self.wall())
+        if self.goal is None or view is None or view.mission_id != self.goal.mission_id:
+            return
+        self.goal.handle.publish_feedback(RunMission.Feedback(
+            mission_id=view.mission_id, state=STATE_TO_MSG[view.state],
+            plan_revision=view.revision, jobs_done=view.jobs_done,
+            jobs_running=view.jobs_running, jobs_total=view.jobs_total,
+            planned_makespan=view.planned_makespan,
+            projected_makespan=view.projected_makespan, elapsed=view.elapsed,
+            reasons=list(view.blocked or view.replan_reasons)))
+
     def publish_status(self) -> None:
         view = self.controller.status(self.wall())
         if view is None:
             return
+        self.publish_feedback()
         ignored = view.ignored
         self.status_pub.publish(MissionStatus(
             stamp=self.get_clock().now().to_msg(), mission_id=view.mission_id,
@@ -374,6 +649,8 @@ class PlannerNode(Node):
 
     def destroy_node(self):
         self.pool.shutdown(wait=False, cancel_futures=True)
+        if self.journal is not None:
+            self.journal.close()
         return super().destroy_node()
 
 

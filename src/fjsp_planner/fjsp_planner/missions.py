@@ -1,0 +1,395 @@
+"""Submit, follow, extend and cancel missions on a running fleet, from a shell or a script.
+
+    ros2 run fjsp_planner mission submit SCENARIO [--panels N] [--time-scale S] [--wait]
+    ros2 run fjsp_planner mission cancel [--reason TEXT]
+    ros2 run fjsp_planner mission add FRAGMENT.yaml
+    ros2 run fjsp_planner mission status
+
+From Python (a test script, a mission monitor):
+
+    from fjsp_planner.missions import MissionClient
+
+    with MissionClient() as client:
+        mission = client.submit('config/scenarios/truss.yaml', feedback=print)
+        client.add_jobs('more_jobs.yaml')
+        result = mission.result(timeout=120)       # MissionResult: state, makespan, ...
+
+The client owns a private ROS context, node and executor thread, so it works whether or not
+the caller uses rclpy, and never spins (or waits on) the caller's nodes. It discovers the
+planner once and stays ready: keep one client for a whole script. A scenario file is sent as
+its YAML text, so the planner may run on another machine.
+"""
+
+import argparse
+import math
+import sys
+import threading
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+RESULT_STATES = ('complete', 'cancelled', 'failed', 'blocked too long', 'rejected')
+"""RunMission.Result.STATE_* in order."""
+
+
+class MissionError(RuntimeError):
+    """A request the fleet did not take: nobody answering, or refused (with its reasons)."""
+
+    def __init__(self, message: str, problems=()):
+        self.problems = list(problems)
+        super().__init__('\n'.join([message, *self.problems]))
+
+
+@dataclass(frozen=True)
+class MissionResult:
+    mission_id: str
+    state: str
+    """One of RESULT_STATES."""
+    makespan: float
+    planned_makespan: float
+    revisions: int
+    jobs_done: int
+    jobs_total: int
+    reasons: tuple[str, ...]
+
+    @property
+    def complete(self) -> bool:
+        return self.state == 'complete'
+
+
+class MissionHandle:
+    """A submitted mission: its id, its feedback as it comes, its result when it ends."""
+
+    def __init__(self, client: 'MissionClient', goal_handle, mission_id: str):
+        self._client = client
+        self._goal = goal_handle
+        self.mission_id = mission_id
+        self._result = goal_handle.get_result_async()
+
+    def result(self, timeout: float | None = None) -> MissionResult:
+        """Wait for the mission to end; MissionError after `timeout` seconds."""
+        if not self._client._wait(self._result, timeout):
+            raise MissionError(f"mission '{self.mission_id}' did not end within {timeout:g} s")
+        return _result(self._result.result().result)
+
+    def cancel(self, timeout: float = 10.0) -> None:
+        future = self._goal.cancel_goal_async()
+        if not self._client._wait(future, timeout):
+            raise MissionError('the planner did not answer the cancel request within '
+                               f'{timeout:g} s')
+        if not future.result().goals_canceling:
+            raise MissionError(f"mission '{self.mission_id}' could not be cancelled: it has "
+                               'ended already')
+
+
+class MissionClient:
+    """Talks to the planner of the fleet on this ROS domain (ROS_DOMAIN_ID and the other
+    ROS variables apply, `domain_id` overrides the first); `args` are ROS arguments, e.g.
+    ['--ros-args', '-r', '__ns:=/cell1']."""
+
+    def __init__(self, args=None, domain_id: int | None = None):
+        import rclpy
+        from rclpy.action import ActionClient
+        from rclpy.executors import SingleThreadedExecutor
+
+        from fjsp_common.contract import (
+            ADD_JOBS_SERVICE,
+            CANCEL_MISSION_SERVICE,
+            LATCHED_QOS,
+            MISSION_STATUS_TOPIC,
+            RUN_MISSION_ACTION,
+        )
+        from fjsp_msgs.action import RunMission
+        from fjsp_msgs.msg import MissionStatus
+        from fjsp_msgs.srv import AddJobs, CancelMission
+
+        self._context = rclpy.Context()
+        try:
+            rclpy.init(args=args, context=self._context, domain_id=domain_id)
+        except RuntimeError as error:  # rclpy's RCLError, e.g. a bad ROS_DOMAIN_ID
+            raise MissionError(f'could not start ROS: {error}') from None
+        self._node = rclpy.create_node(f'mission_client_{time.time_ns()}',
+                                       context=self._context)
+        self._action_name = RUN_MISSION_ACTION
+        self._action = ActionClient(self._node, RunMission, RUN_MISSION_ACTION)
+        self._add = self._node.create_client(AddJobs, ADD_JOBS_SERVICE)
+        self._cancel = self._node.create_client(CancelMission, CANCEL_MISSION_SERVICE)
+        self._status = None
+        self._status_seen = threading.Event()
+        self._node.create_subscription(MissionStatus, MISSION_STATUS_TOPIC, self._on_status,
+                                       LATCHED_QOS)
+        self._executor = SingleThreadedExecutor(context=self._context)
+        self._executor.add_node(self._node)
+        self._thread = threading.Thread(target=self._spin, daemon=True)
+        self._thread.start()
+
+    def _spin(self):
+        while self._context.ok():
+            try:
+                self._executor.spin_once(timeout_sec=0.1)
+            except Exception:  # noqa: BLE001  the context went down between checks
+                if self._context.ok():
+                    raise
+
+    def _on_status(self, msg):
+        self._status = msg
+        self._status_seen.set()
+
+    def _wait(self, future, timeout) -> bool:
+        done = threading.Event()
+        future.add_done_callback(lambda _: done.set())
+        return done.wait(timeout)
+
+    def close(self) -> None:
+        import rclpy
+
+        self._executor.shutdown(timeout_sec=1.0)
+        self._node.destroy_node()
+        rclpy.try_shutdown(context=self._context)
+        self._thread.join(timeout=2.0)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    # --- requests --------------------------------------------------------------------------
+
+    def submit(self, scenario=None, *, scenario_yaml: str = '', name: str = '',
+               panels: int = 0, shift: float = -1.0, time_scale: float = 0.0,
+               time_limit: float = 0.0, replan_time_limit: float = 0.0,
+               blocked_timeout: float = 0.0, feedback=None,
+               timeout: float = 10.0) -> MissionHandle:
+        """Start a mission: `scenario` is a file (sent as its text), or give the text as
+        `scenario_yaml`. `feedback(RunMission.Feedback)` is called as the mission goes.
+        MissionError if the planner does not answer within `timeout` or rejects it (with
+        every problem of the scenario)."""
+        from fjsp_msgs.action import RunMission
+
+        if (scenario is None) == (not scenario_yaml):
+            raise MissionError('give a scenario file or scenario_yaml (one of them)')
+        if scenario is not None:
+            path = Path(scenario)
+            try:
+                scenario_yaml = path.read_text()
+            except (OSError, UnicodeDecodeError) as error:
+                raise MissionError(f'{path}: cannot read the scenario: {error}') from None
+            name = name or path.stem
+        goal = RunMission.Goal(scenario_yaml=scenario_yaml, scenario_name=name, panels=panels,
+                               shift=shift, time_limit=time_limit,
+                               replan_time_limit=replan_time_limit, time_scale=time_scale,
+                               blocked_timeout=blocked_timeout)
+        if not self._action.wait_for_server(timeout_sec=timeout):
+            raise MissionError(f"no planner serves '{self._action_name}' (waited "
+                               f'{timeout:g} s): is the planner running, with the same '
+                               'ROS_DOMAIN_ID?')
+        first = threading.Event()
+        named = []
+
+        def on_feedback(msg):
+            if not first.is_set():
+                named.append(msg.feedback.mission_id)
+                first.set()
+            if feedback is not None:
+                feedback(msg.feedback)
+
+        accepted = self._action.send_goal_async(goal, feedback_callback=on_feedback)
+        if not self._wait(accepted, timeout):
+            raise MissionError(f'the planner did not answer the goal within {timeout:g} s')
+        goal_handle = accepted.result()
+        if not goal_handle.accepted:
+            raise MissionError('the planner refused the goal')
+        handle = MissionHandle(self, goal_handle, '')
+        # A started mission names itself in its first feedback; a rejected one ends at once.
+        deadline = time.monotonic() + timeout
+        while not first.is_set() and not handle._result.done() \
+                and time.monotonic() < deadline:
+            first.wait(0.02)
+        if handle._result.done():
+            result = _result(handle._result.result().result)
+            if result.state == 'rejected':
+                raise MissionError('mission rejected', result.reasons)
+            handle.mission_id = result.mission_id
+        elif named:
+            handle.mission_id = named[0]
+        else:
+            raise MissionError(f'the planner accepted the goal but said nothing of it within '
+                               f'{timeout:g} s')
+        return handle
+
+    def run(self, scenario=None, *, timeout: float | None = None, **goal) -> MissionResult:
+        """`submit`, then wait up to `timeout` seconds for the result."""
+        return self.submit(scenario, **goal).result(timeout)
+
+    def cancel(self, mission_id: str = '', reason: str = '', timeout: float = 10.0) -> str:
+        """Cancel the running mission (or `mission_id`); the planner's answer."""
+        from fjsp_msgs.srv import CancelMission
+
+        response = self._call(self._cancel, CancelMission.Request(mission_id=mission_id,
+                                                                  reason=reason), timeout)
+        if not response.success:
+            raise MissionError(response.message)
+        return response.message
+
+    def add_jobs(self, fragment=None, *, fragment_yaml: str = '', mission_id: str = '',
+                 timeout: float = 10.0) -> list[str]:
+        """Add the jobs of a scenario fragment (a file, or its text) to the running mission;
+        the names added. MissionError lists every problem of a refused fragment."""
+        from fjsp_msgs.srv import AddJobs
+
+        if (fragment is None) == (not fragment_yaml):
+            raise MissionError('give a fragment file or fragment_yaml (one of them)')
+        if fragment is not None:
+            try:
+                fragment_yaml = Path(fragment).read_text()
+            except (OSError, UnicodeDecodeError) as error:
+                raise MissionError(f'{fragment}: cannot read the fragment: {error}') from None
+        response = self._call(self._add, AddJobs.Request(mission_id=mission_id,
+                                                         fragment_yaml=fragment_yaml), timeout)
+        if not response.success:
+            raise MissionError(response.message, response.problems)
+        return list(response.jobs)
+
+    def status(self, timeout: float = 10.0):
+        """The latest MissionStatus (latched: it comes as soon as the planner is found)."""
+        if not self._status_seen.wait(timeout):
+            raise MissionError(f'no mission status within {timeout:g} s: is the planner '
+                               'running, with the same ROS_DOMAIN_ID?')
+        return self._status
+
+    def _call(self, client, request, timeout):
+        if not client.wait_for_service(timeout_sec=timeout):
+            raise MissionError(f"no planner serves '{client.srv_name}' (waited {timeout:g} s)"
+                               ': is the planner running, with the same ROS_DOMAIN_ID?')
+        future = client.call_async(request)
+        if not self._wait(future, timeout):
+            client.remove_pending_request(future)
+            raise MissionError(f"'{client.srv_name}' did not answer within {timeout:g} s")
+        return future.result()
+
+
+def _result(msg) -> MissionResult:
+    state = RESULT_STATES[msg.state] if msg.state < len(RESULT_STATES) else f'state {msg.state}'
+    return MissionResult(msg.mission_id, state, msg.makespan, msg.planned_makespan,
+                         msg.revisions, msg.jobs_done, msg.jobs_total, tuple(msg.reasons))
+
+
+# --- command line ------------------------------------------------------------------------
+
+def describe_feedback(feedback) -> str:
+    from fjsp_common.contract import STATE_FROM_MSG
+
+    state = STATE_FROM_MSG.get(feedback.state, f'state {feedback.state}')
+    line = (f'{feedback.mission_id}: {state}, revision {feedback.plan_revision}, '
+            f'{feedback.jobs_done}/{feedback.jobs_total} jobs done, {feedback.jobs_running} '
+            f'running, makespan planned {feedback.planned_makespan:.2f} projected '
+            f'{feedback.projected_makespan:.2f}, t={feedback.elapsed:.1f}')
+    return line + (': ' + '; '.join(feedback.reasons) if feedback.reasons else '')
+
+
+def describe_result(result: MissionResult) -> str:
+    makespan = f', executed makespan {result.makespan:.2f}' \
+        if math.isfinite(result.makespan) else ''
+    return (f'{result.mission_id}: {result.state}, {result.jobs_done}/{result.jobs_total} jobs '
+            f'done, {result.revisions} revision(s){makespan}'
+            + (': ' + '; '.join(result.reasons) if result.reasons else ''))
+
+
+def _parser():
+    parser = argparse.ArgumentParser(prog='mission', description='Missions on a running '
+                                     'fleet: submit, cancel, extend, status.')
+    verbs = parser.add_subparsers(dest='verb', required=True)
+    submit = verbs.add_parser('submit', help='run a mission (a scenario file)')
+    submit.add_argument('scenario', type=Path)
+    submit.add_argument('--panels', type=int, default=0, help="0: the scenario's own")
+    submit.add_argument('--time-scale', type=float, default=0.0,
+                        help="wall seconds per schedule unit; 0: the planner's")
+    submit.add_argument('--blocked-timeout', type=float, default=0.0,
+                        help='fail the mission after being blocked this long (s); 0: never')
+    submit.add_argument('--wait', action='store_true',
+                        help='follow the mission to its end, printing its progress; exit 0 '
+                             'only if it completes')
+    cancel = verbs.add_parser('cancel', help='cancel the running mission')
+    cancel.add_argument('--reason', default='', help='shown in the mission story')
+    add = verbs.add_parser('add', help='add the jobs of a scenario fragment')
+    add.add_argument('fragment', type=Path)
+    verbs.add_parser('status', help='print the mission state and jobs done')
+    for verb in (submit, cancel, add, verbs.choices['status']):
+        verb.add_argument('--timeout', type=float, default=10.0,
+                          help='seconds to wait for the planner (default 10)')
+    return parser
+
+
+def main(argv=None) -> int:
+    """Exit 0: done (submit --wait: the mission completed); 1: refused, failed, nobody
+    answered; 2: bad arguments."""
+    from rclpy.utilities import remove_ros_args
+
+    argv = sys.argv[1:] if argv is None else list(argv)
+    parser = _parser()
+    try:
+        own = remove_ros_args(['mission', *argv])[1:]
+    except RuntimeError as error:  # rclpy's RCLInvalidROSArgsError
+        parser.error(f'bad ROS arguments: {error}')
+    args = parser.parse_args(own)
+    if not (math.isfinite(args.timeout) and args.timeout > 0):
+        parser.error(f'--timeout must be a number of seconds > 0, got {args.timeout:g}')
+    if args.verb == 'submit':
+        for flag, value in (('--time-scale', args.time_scale),
+                            ('--blocked-timeout', args.blocked_timeout)):
+            if not (math.isfinite(value) and value >= 0):
+                parser.error(f'{flag} must be a number >= 0, got {value:g}')
+        if not 0 <= args.panels <= 50:
+            parser.error(f'--panels must be within 0..50, got {args.panels}')
+    try:
+        with MissionClient(['mission', *argv]) as client:
+            return _run(client, args)
+    except MissionError as error:
+        print(f'mission: {error}', file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        return 130
+
+
+def _run(client: MissionClient, args) -> int:
+    if args.verb == 'submit':
+        shown = []
+
+        def show(feedback):
+            line = describe_feedback(feedback)
+            if args.wait and (not shown or line.split(', t=')[0] != shown[-1]):
+                shown.append(line.split(', t=')[0])
+                print(line, flush=True)
+
+        mission = client.submit(args.scenario, panels=args.panels, time_scale=args.time_scale,
+                                blocked_timeout=args.blocked_timeout, feedback=show,
+                                timeout=args.timeout)
+        print(f'mission {mission.mission_id} started', flush=True)
+        if not args.wait:
+            return 0
+        result = mission.result()
+        print(describe_result(result))
+        return 0 if result.complete else 1
+    if args.verb == 'cancel':
+        print(client.cancel(reason=args.reason, timeout=args.timeout))
+        return 0
+    if args.verb == 'add':
+        jobs = client.add_jobs(args.fragment, timeout=args.timeout)
+        print(f'{len(jobs)} job(s) added: {", ".join(jobs)}')
+        return 0
+    from fjsp_common.contract import STATE_FROM_MSG
+
+    status = client.status(args.timeout)
+    state = STATE_FROM_MSG.get(status.state, f'state {status.state}')
+    print(f'{state} {status.jobs_done}/{status.jobs_total}  mission {status.mission_id} '
+          f'revision {status.plan_revision}')
+    for reason in status.blocked_reasons:
+        print(f'  blocked: {reason}')
+    for warning in status.warnings:
+        print(f'  warning: {warning}')
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())
