@@ -1,12 +1,13 @@
 """Fixtures of the integration tests; the harness itself is in harness.py."""
 
 import pytest
-from harness import Launcher, Observer, new_domain
+from harness import Launcher, Observer, private_domain
 
 
 @pytest.fixture
 def domain():
-    return new_domain()
+    with private_domain() as domain:
+        yield domain
 
 
 @pytest.fixture

@@ -5,14 +5,17 @@ test process that records every public topic, and a launcher whose processes are
 (SIGINT, then SIGKILL of the whole process group) whatever the test does.
 """
 
-import itertools
+import fcntl
 import os
+import random
 import shutil
 import signal
 import subprocess
+import tempfile
 import threading
 import time
 from collections import defaultdict
+from contextlib import contextmanager
 from fractions import Fraction
 from pathlib import Path
 
@@ -46,12 +49,32 @@ ROBOTS = (('Assembler', 'assembler_agent'), ('LSMS', 'lsms_agent'),
 TIME_SCALE = 0.03
 """Wall seconds per schedule unit: the 32-unit mission takes about a second."""
 
-# Distinct domains per test, offset by the process id so concurrent runs rarely meet.
-_domains = itertools.count((os.getpid() * 7) % 60)
+DOMAINS = range(1, 101)
+"""ROS domain ids Fast DDS can use on one host (each maps to its own ports)."""
 
 
-def new_domain() -> int:
-    return 1 + next(_domains) % 100
+@contextmanager
+def private_domain():
+    """A ROS domain id no other test process on this machine holds while the block runs:
+    each is claimed with an exclusive lock on a file, released when the block ends or the
+    process dies. Without it, two test runs at once (two checkouts, CI and a developer) can
+    share a domain and see each other's robots."""
+    start = random.randrange(len(DOMAINS))
+    for index in range(len(DOMAINS)):
+        domain = DOMAINS[(start + index) % len(DOMAINS)]
+        lock = open(f'{tempfile.gettempdir()}/fjsp-ros-domain-{domain}.lock', 'w')  # noqa: SIM115
+        try:
+            fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            lock.close()
+            continue
+        try:
+            yield domain
+        finally:
+            lock.close()
+        return
+    raise RuntimeError(f'every ROS domain id {DOMAINS.start}..{DOMAINS.stop - 1} is in use '
+                       'by other test processes on this machine')
 
 
 class Launcher:
@@ -66,7 +89,8 @@ class Launcher:
         command = ['ros2', 'run', package, executable, *extra, '--ros-args',
                    '-r', f'__node:={name}']
         for key, value in params:
-            command += ['-p', f'{key}:={value}']
+            if value is not None:
+                command += ['-p', f'{key}:={value}']
         log = (self.logs / f'{name}.log').open('w')
         self.processes[name] = subprocess.Popen(command, env=self.env, stdout=log,
                                                 stderr=subprocess.STDOUT,

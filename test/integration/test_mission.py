@@ -1,7 +1,7 @@
 """A whole mission over real processes: planner + the paper's four robots, via `ros2 run`."""
 
 import pytest
-from harness import ROBOTS, SCENARIO, Launcher, Observer, executed_timeline, new_domain
+from harness import ROBOTS, SCENARIO, Launcher, Observer, executed_timeline, private_domain
 
 from fjsp_msgs.msg import MissionStatus, TaskEvent
 from fjsp_planner.core.scenario import load_scenario
@@ -15,7 +15,11 @@ is the rounding-up of reported ends (1e-6 units per leg or operation)."""
 @pytest.fixture(scope='module')
 def mission(tmp_path_factory):
     """One mission shared by this module's tests (each check reads the same run)."""
-    domain = new_domain()
+    with private_domain() as domain:
+        yield from _mission(domain, tmp_path_factory)
+
+
+def _mission(domain, tmp_path_factory):
     launcher = Launcher(domain, tmp_path_factory.mktemp('mission'))
     observer = Observer(domain)
     try:

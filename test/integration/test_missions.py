@@ -1,0 +1,170 @@
+"""Missions as a service over real processes: successive missions on one fleet, cancel,
+rejected goals, jobs added mid-mission, and a planner killed and restarted mid-mission."""
+
+import time
+from collections import Counter
+
+import pytest
+import yaml
+from harness import ROBOTS, SCENARIO, executed_timeline
+
+from fjsp_msgs.msg import MissionStatus, RobotState, TaskEvent
+from fjsp_planner.core.scenario import load_scenario
+from fjsp_planner.core.validate import validate
+from fjsp_planner.missions import MissionClient, MissionError
+
+SLOW = 0.1
+"""Wall seconds per schedule unit: one panel takes about 3 s."""
+
+
+@pytest.fixture
+def fleet(launcher, observer, domain):
+    """An idle planner (no scenario: it waits for goals) and the paper's four agents."""
+    launcher.start_planner(scenario=None, time_scale=SLOW)
+    for robot, _ in ROBOTS:
+        launcher.start_agent(robot)
+    observer.wait_for(lambda o: len(o.robots) == 4, 30, 'the four agents')
+    with MissionClient(domain_id=domain) as client:
+        yield client
+
+
+def of_mission(observer, mission_id):
+    with observer.lock:
+        plans = [p for p in observer.plans if p.mission_id == mission_id]
+        events = [e for e in observer.events if e.mission_id == mission_id]
+    return plans, events
+
+
+def check_done_once(problem, observer, mission_id):
+    """Every job of `problem` started and completed exactly once by each of its robots, and
+    the executed timeline is valid."""
+    observer.wait_for(lambda o: sum(e.kind == TaskEvent.KIND_JOB_DONE and e.mission_id ==
+                                    mission_id for e in o.events) >= len(problem.jobs), 10,
+                      'every job-done event')
+    plans, events = of_mission(observer, mission_id)
+    starts = Counter((e.job, e.robot) for e in events if e.kind == TaskEvent.KIND_STARTED)
+    assert set(starts.values()) == {1}, starts
+    executed = executed_timeline(problem, plans, events)
+    assert sorted(executed.jobs) == sorted(j.name for j in problem.jobs)
+    assert validate(problem, executed) == []
+
+
+def idle_fleet(observer):
+    return all(r.mode == RobotState.MODE_IDLE and not r.current_job
+               for r in observer.robots.values())
+
+
+def test_successive_missions_on_one_fleet(fleet, observer):
+    first = fleet.run(SCENARIO, timeout=90)
+    assert first.complete, first
+    assert (first.jobs_done, first.jobs_total) == (12, 12)
+    assert abs(first.makespan - 32) < 1e-3
+    check_done_once(load_scenario(SCENARIO), observer, first.mission_id)
+
+    second = fleet.run(SCENARIO, panels=2, timeout=120)
+    assert second.complete, second
+    assert second.mission_id != first.mission_id and second.jobs_done == 24
+    check_done_once(load_scenario(SCENARIO, panels=2), observer, second.mission_id)
+    # Revisions count per mission, and nothing of the first leaked into the second.
+    plans, _ = of_mission(observer, second.mission_id)
+    assert plans[0].revision == 1
+
+
+def test_goal_during_a_mission_and_broken_goal_are_rejected(fleet, observer):
+    running = fleet.submit(SCENARIO)
+    with pytest.raises(MissionError, match='one mission per fleet') as busy:
+        fleet.submit(SCENARIO)
+    assert running.mission_id in str(busy.value)
+    broken = {'operation_types': {0: 'weld'}, 'robot_types': {'W': {'weld': 1}},
+              'robots': [{'name': 'R1', 'type': 'Welder'}],
+              'jobs': [{'name': 'A', 'plans': [['weld']]}, {'name': 'B', 'plans': [['glue']]}],
+              'precedence': [['A', 'B'], ['B', 'A']]}
+    with pytest.raises(MissionError) as bad:
+        fleet.submit(scenario_yaml=yaml.safe_dump(broken))
+    text = '\n'.join(bad.value.problems)
+    assert "'glue'" in text, text
+    assert running.result(timeout=60).complete  # the running mission was untouched
+
+
+def test_cancel_leaves_the_fleet_idle_for_the_next_mission(fleet, observer):
+    mission = fleet.submit(SCENARIO)
+    observer.wait_for(lambda o: o.status is not None
+                      and o.status.mission_id == mission.mission_id
+                      and o.status.jobs_done >= 2, 30, 'the mission under way')
+    mission.cancel()
+    result = mission.result(timeout=30)
+    assert result.state == 'cancelled' and result.jobs_done < 12
+    observer.wait_for(lambda o: o.status.state == MissionStatus.STATE_CANCELLED
+                      and idle_fleet(o), 15, 'an idle fleet')
+    _, events = of_mission(observer, mission.mission_id)
+    assert any(e.kind == TaskEvent.KIND_ABORTED and e.reason == 'mission cancelled'
+               for e in events) or not any(e.kind == TaskEvent.KIND_STARTED
+                                           for e in events[-4:])
+    third = fleet.run(SCENARIO, timeout=90)
+    assert third.complete and third.jobs_done == 12
+    check_done_once(load_scenario(SCENARIO), observer, third.mission_id)
+
+
+def second_panel(problem, shift=60) -> str:
+    """The fragment adding a copy of `problem`'s jobs `shift` away: a second panel."""
+    tag = '{}_2'.format
+    locations = problem.locations()
+    pairs = [[tag(a), tag(b), str(problem.distance(a, b))]
+             for i, a in enumerate(locations) for b in locations[i + 1:]]
+    pairs += [[tag(a), b, str(problem.distance(a, b) + shift)]
+              for a in locations for b in locations]
+    return yaml.safe_dump({
+        'jobs': [{'name': tag(j.name), 'location': tag(j.location),
+                  'plans': [list(p) for p in j.plans]} for j in problem.jobs],
+        'distances': {'pairs': pairs},
+        'precedence': [[tag(a), tag(b)] for a, b in problem.precedence],
+        'holding': [[tag(a), tag(b), q] for a, b, q in problem.holding]})
+
+
+def test_a_second_panel_added_mid_mission(fleet, observer):
+    problem = load_scenario(SCENARIO)
+    mission = fleet.submit(SCENARIO)
+    observer.wait_for(lambda o: o.status is not None
+                      and o.status.mission_id == mission.mission_id
+                      and o.status.jobs_done >= 1, 30, 'the first panel under way')
+    with pytest.raises(MissionError) as bad:
+        fleet.add_jobs(fragment_yaml=yaml.safe_dump({'jobs': [{'name': 'X', 'plans': [[0]]}],
+                                                     'precedence': [['X', 'Nowhere']]}))
+    assert any('Nowhere' in p for p in bad.value.problems), bad.value.problems
+    added = fleet.add_jobs(fragment_yaml=second_panel(problem))
+    assert len(added) == 12
+    result = mission.result(timeout=120)
+    assert result.complete and (result.jobs_done, result.jobs_total) == (24, 24), result
+    _, events = of_mission(observer, mission.mission_id)
+    extended = load_scenario(SCENARIO, panels=1)
+    from fjsp_planner.core.extension import extend
+
+    extended, _ = extend(extended, second_panel(problem))
+    check_done_once(extended, observer, mission.mission_id)
+
+
+def test_planner_killed_mid_mission_resumes_it(launcher, observer, tmp_path):
+    problem = load_scenario(SCENARIO)
+    journal = tmp_path / 'journal'
+    planner = {'time_scale': 0.15, 'journal_dir': journal}
+    launcher.start_planner(**planner)
+    for robot, _ in ROBOTS:
+        launcher.start_agent(robot)
+    observer.wait_for(lambda o: o.status is not None and o.status.jobs_done >= 3, 40,
+                      'the mission under way')
+    mission_id = observer.status.mission_id
+    launcher.kill('planner')
+    time.sleep(0.5)
+    launcher.start_planner(**planner)
+    observer.wait_for(lambda o: o.status.state == MissionStatus.STATE_COMPLETE
+                      and o.status.mission_id == mission_id, 90,
+                      'the same mission completed by the restarted planner')
+    assert 'resuming mission' in launcher.log('planner')
+    check_done_once(problem, observer, mission_id)
+    # Restarted once more after the end: it does not run the mission again.
+    launcher.stop('planner')
+    launcher.start_planner(**planner)
+    time.sleep(3)
+    assert 'not starting' in launcher.log('planner')
+    plans, _ = of_mission(observer, mission_id)
+    assert len({p.mission_id for p in observer.plans}) == 1
