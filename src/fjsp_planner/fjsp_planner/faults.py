@@ -53,7 +53,7 @@ def check_fault(fault: str, factor: float | None) -> float:
 
 
 def inject_fault(robot: str, fault: str, factor: float | None = None, *, node=None,
-                 timeout: float = 5.0) -> str:
+                 timeout: float = 5.0, key_file=None) -> str:
     """Inject `fault` ('fail', 'recover' or 'delay' with `factor`) into `robot`'s agent.
 
     Returns the agent's message. Waits up to `timeout` seconds for the agent's service to
@@ -64,15 +64,17 @@ def inject_fault(robot: str, fault: str, factor: float | None = None, *, node=No
     context. Both honour ROS_DOMAIN_ID and the other ROS environment variables. A new
     node (hence every private one) first waits for DDS discovery, up to about 3 s with
     Fast DDS on localhost; a node that has been running a while gets its answer in
-    milliseconds, so pass one when the fault must land at a precise moment.
+    milliseconds, so pass one when the fault must land at a precise moment. In a fleet with
+    a key, the request is signed with the key in `key_file` (default: the file named by
+    $FJSP_FLEET_KEY_FILE).
     """
     factor = check_fault(fault, factor)
     if not (isinstance(timeout, int | float) and math.isfinite(timeout) and timeout > 0):
         raise FaultError(f'timeout must be a number of seconds > 0, got {timeout!r}')
     if node is not None:
-        return _call(node, robot, fault, factor, timeout)
+        return _call(node, robot, fault, factor, timeout, key_file)
     with _own_node(args=[]) as own:
-        return _call(own, robot, fault, factor, timeout)
+        return _call(own, robot, fault, factor, timeout, key_file)
 
 
 @contextmanager
@@ -95,9 +97,10 @@ def _own_node(args):
         rclpy.try_shutdown(context=context)
 
 
-def _call(node, robot, fault, factor, timeout) -> str:
+def _call(node, robot, fault, factor, timeout, key_file) -> str:
     from rclpy.exceptions import InvalidServiceNameException
 
+    from fjsp_common.auth import FleetKeyError, client_signer
     from fjsp_common.contract import INJECT_FAULT_SERVICE
     from fjsp_msgs.srv import InjectFault
 
@@ -113,6 +116,11 @@ def _call(node, robot, fault, factor, timeout) -> str:
                              'agent running, with the same ROS_DOMAIN_ID?')
         request = InjectFault.Request(
             fault=getattr(InjectFault.Request, f'FAULT_{fault.upper()}'), factor=factor)
+        try:
+            signer = client_signer(key_file, f'inject_fault/{node.get_name()}')
+        except FleetKeyError as error:
+            raise FaultError(str(error)) from None
+        signer.sign(request, name)
         future = client.call_async(request)
         if not _wait(node, future, timeout):
             client.remove_pending_request(future)
@@ -161,6 +169,9 @@ def main(argv=None) -> int:
     parser.add_argument('--factor', type=float,
                         help="delay only: multiply the current (or next) operation's "
                              'duration by F (> 0)')
+    parser.add_argument('--key-file', metavar='FILE',
+                        help='fleet key to sign the request with (default: '
+                             '$FJSP_FLEET_KEY_FILE; none: unsigned)')
     parser.add_argument('--timeout', type=float, default=5.0, metavar='S',
                         help='seconds to wait for the agent to appear, and then to answer '
                              '(default 5)')
@@ -178,7 +189,7 @@ def main(argv=None) -> int:
     try:
         # rclpy reads the --ros-args part (remappings, log level, ...) itself.
         with _own_node(['inject_fault', *argv]) as node:
-            print(_call(node, args.robot, args.fault, factor, args.timeout))
+            print(_call(node, args.robot, args.fault, factor, args.timeout, args.key_file))
     except FaultError as error:
         print(f'inject_fault: {error}', file=sys.stderr)
         return 1

@@ -73,6 +73,10 @@ class MissionHandle:
         return _result(self._result.result().result)
 
     def cancel(self, timeout: float = 10.0) -> None:
+        if self._client._signer.key is not None:
+            # An action's cancel cannot be signed; the signed service does the same.
+            self._client.cancel(self.mission_id, timeout=timeout)
+            return
         future = self._goal.cancel_goal_async()
         if not self._client._wait(future, timeout):
             raise MissionError('the planner did not answer the cancel request within '
@@ -85,13 +89,15 @@ class MissionHandle:
 class MissionClient:
     """Talks to the planner of the fleet on this ROS domain (ROS_DOMAIN_ID and the other
     ROS variables apply, `domain_id` overrides the first); `args` are ROS arguments, e.g.
-    ['--ros-args', '-r', '__ns:=/cell1']."""
+    ['--ros-args', '-r', '__ns:=/cell1']. Requests are signed with the fleet key in
+    `key_file` (default: the file named by $FJSP_FLEET_KEY_FILE; none: unsigned)."""
 
-    def __init__(self, args=None, domain_id: int | None = None):
+    def __init__(self, args=None, domain_id: int | None = None, key_file=None):
         import rclpy
         from rclpy.action import ActionClient
         from rclpy.executors import SingleThreadedExecutor
 
+        from fjsp_common.auth import FleetKeyError, client_signer
         from fjsp_common.contract import (
             ADD_JOBS_SERVICE,
             CANCEL_MISSION_SERVICE,
@@ -103,6 +109,10 @@ class MissionClient:
         from fjsp_msgs.msg import MissionStatus
         from fjsp_msgs.srv import AddJobs, CancelMission
 
+        try:
+            self._signer = client_signer(key_file, 'mission_client')
+        except FleetKeyError as error:
+            raise MissionError(str(error)) from None
         self._context = rclpy.Context()
         try:
             rclpy.init(args=args, context=self._context, domain_id=domain_id)
@@ -180,6 +190,7 @@ class MissionClient:
                                shift=shift, time_limit=time_limit,
                                replan_time_limit=replan_time_limit, time_scale=time_scale,
                                blocked_timeout=blocked_timeout)
+        self._signer.sign(goal, self._node.resolve_topic_name(self._action_name))
         if not self._action.wait_for_server(timeout_sec=timeout):
             raise MissionError(f"no planner serves '{self._action_name}' (waited "
                                f'{timeout:g} s): is the planner running, with the same '
@@ -259,6 +270,7 @@ class MissionClient:
         return self._status
 
     def _call(self, client, request, timeout):
+        self._signer.sign(request, self._node.resolve_service_name(client.srv_name))
         if not client.wait_for_service(timeout_sec=timeout):
             raise MissionError(f"no planner serves '{client.srv_name}' (waited {timeout:g} s)"
                                ': is the planner running, with the same ROS_DOMAIN_ID?')
@@ -318,6 +330,8 @@ def _parser():
     for verb in (submit, cancel, add, verbs.choices['status']):
         verb.add_argument('--timeout', type=float, default=10.0,
                           help='seconds to wait for the planner (default 10)')
+        verb.add_argument('--key-file', help='fleet key to sign requests with (default: '
+                                             '$FJSP_FLEET_KEY_FILE; none: unsigned)')
     return parser
 
 
@@ -343,7 +357,7 @@ def main(argv=None) -> int:
         if not 0 <= args.panels <= 50:
             parser.error(f'--panels must be within 0..50, got {args.panels}')
     try:
-        with MissionClient(['mission', *argv]) as client:
+        with MissionClient(['mission', *argv], key_file=args.key_file) as client:
             return _run(client, args)
     except MissionError as error:
         print(f'mission: {error}', file=sys.stderr)

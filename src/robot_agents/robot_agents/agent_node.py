@@ -12,13 +12,13 @@ through `<robot_name>/inject_fault` (`fjsp_planner.faults`).
 """
 
 import sys
-import time
 from collections import deque
 
 from rclpy.exceptions import InvalidServiceNameException
 from rclpy.node import Node
 from rclpy.time import Time as RosTime
 
+from fjsp_common.auth import PLANNER, NodeAuth
 from fjsp_common.contract import (
     EVENT_FROM_MSG,
     EVENT_HISTORY,
@@ -64,7 +64,8 @@ class RobotAgent(Node):
                                  f"'{pinned_type}', got '{self.pinned_type}' (use robot_agent "
                                  'for other types)')
 
-        self.incarnation = time.time_ns()
+        self.auth = NodeAuth(self, self.robot)
+        self.incarnation = self.auth.signer.incarnation
         """Tells this process's reports from those of an earlier agent of the same robot."""
         self.event_count = 0
         self.failures = 0
@@ -83,9 +84,9 @@ class RobotAgent(Node):
         self.event_pub = self.create_publisher(TaskEvent, TASK_EVENTS_TOPIC, EVENTS_QOS)
         self.create_subscription(Plan, PLAN_TOPIC, self.on_plan, LATCHED_QOS)
         self.create_subscription(TaskEvent, TASK_EVENTS_TOPIC, self.on_event, EVENTS_QOS)
+        self.fault_service = f'{self.robot}/{INJECT_FAULT_SERVICE}'
         try:
-            self.create_service(InjectFault, f'{self.robot}/{INJECT_FAULT_SERVICE}',
-                                self.on_fault)
+            self.create_service(InjectFault, self.fault_service, self.on_fault)
         except InvalidServiceNameException:
             raise ParameterError(f"parameter 'robot_name' must be usable in a ROS name "
                                  f'(letters, digits, underscores), got {self.robot!r}') from None
@@ -105,6 +106,8 @@ class RobotAgent(Node):
     # --- plans -------------------------------------------------------------------------
 
     def on_plan(self, msg: Plan) -> None:
+        if not self.auth.accept(msg, PLAN_TOPIC, {PLANNER}):
+            return
         log = self.get_logger()
         mission = shorten(msg.mission_id, 80)
         new_mission = msg.mission_id != self.mission_id
@@ -198,6 +201,9 @@ class RobotAgent(Node):
     # --- what the others report --------------------------------------------------------
 
     def on_event(self, msg: TaskEvent) -> None:
+        senders = {PLANNER} if msg.kind == TaskEvent.KIND_JOB_DONE else {msg.robot}
+        if not self.auth.accept(msg, TASK_EVENTS_TOPIC, senders):
+            return
         if msg.mission_id != self.mission_id:
             # The plan of a mission may come after the first reports of the others.
             self.early_events.append(msg)
@@ -224,6 +230,11 @@ class RobotAgent(Node):
     # --- faults ------------------------------------------------------------------------
 
     def on_fault(self, request, response):
+        if not self.auth.accept(request, self.fault_service, service=True):
+            response.success = False
+            response.message = (f"robot '{self.robot}': fault refused, the request is not "
+                                'signed with the fleet key')
+            return response
         now = self.now_units()
         # Before the first plan nothing runs, so the time of a fault does not matter.
         now = 0.0 if now is None else max(now, 0.0)
@@ -266,12 +277,12 @@ class RobotAgent(Node):
     def publish_events(self, events) -> None:
         for e in events:
             self.event_count += 1
-            self.event_pub.publish(TaskEvent(
+            self.event_pub.publish(self.auth.sign(TaskEvent(
                 stamp=self.get_clock().now().to_msg(),
                 event_id=f'{self.robot}/{self.incarnation}/{self.event_count}',
                 mission_id=self.mission_id, kind=EVENT_TO_MSG[e.kind], robot=self.robot,
                 job=e.job, plan_revision=self.execution.revision, time=e.time,
-                reason=e.reason))
+                reason=e.reason), TASK_EVENTS_TOPIC))
             self.get_logger().info(f'{e.kind.value} {e.job} at t={e.time:.2f} (attempt '
                                    f'{e.attempt})' + (f' ({e.reason})' if e.reason else ''))
 
@@ -279,7 +290,7 @@ class RobotAgent(Node):
         now = self.now_units()
         execution = self.execution
         self.last_state = self.state_key()
-        self.state_pub.publish(RobotState(
+        self.state_pub.publish(self.auth.sign(RobotState(
             stamp=self.get_clock().now().to_msg(), robot=self.robot,
             robot_type=self.robot_type, incarnation=self.incarnation,
             mission_id=self.mission_id, mode=MODE_TO_MSG[execution.mode],
@@ -287,7 +298,7 @@ class RobotAgent(Node):
             current_job=execution.current_job, location=execution.location,
             destination=execution.destination,
             progress=execution.progress(now) if now is not None else 0.0,
-            busy_until=execution.busy_until))
+            busy_until=execution.busy_until), ROBOT_STATES_TOPIC))
 
 
 def agent_node_name(robot: str) -> str:

@@ -20,6 +20,7 @@ from rclpy.node import Node
 from rclpy.task import Future as RosFuture
 from rclpy.time import Time
 
+from fjsp_common.auth import PLANNER, NodeAuth
 from fjsp_common.contract import (
     ADD_JOBS_SERVICE,
     CANCEL_MISSION_SERVICE,
@@ -39,7 +40,7 @@ from fjsp_common.contract import (
     TASK_EVENTS_TOPIC,
 )
 from fjsp_common.running import ParameterError, declare, run_node, shorten
-from fjsp_common.vocabulary import EventKind, MissionEventKind, MissionState
+from fjsp_common.vocabulary import MissionEventKind, MissionState
 from fjsp_msgs.action import RunMission
 from fjsp_msgs.msg import JobStates, MissionEvent, MissionStatus, Plan, RobotState, TaskEvent
 from fjsp_msgs.srv import AddJobs, CancelMission
@@ -178,6 +179,7 @@ class PlannerNode(Node):
                                      + '\n'.join(problems)) from None
             origin = origin_of(text, panels, shift)
 
+        self.auth = NodeAuth(self, PLANNER)
         self.controller = MissionController(self.settings())
         self.journal: Journal | None = None
         self.goal: Goal | None = None
@@ -185,7 +187,7 @@ class PlannerNode(Node):
         self.last_published = None
         """(mission, revision, stamp) of this node's latest plan, which it hears back."""
         self.event_count = 0
-        self.incarnation = secrets.token_hex(4)
+        self.incarnation = self.auth.signer.incarnation
         self.solves: dict[int, Future] = {}
         # One worker thread: the solve runs there so the executor keeps serving callbacks.
         self.pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix='solver')
@@ -295,6 +297,8 @@ class PlannerNode(Node):
 
     async def execute_goal(self, handle):
         goal = handle.request
+        if not self.auth.accept(goal, RUN_MISSION_ACTION):
+            return self.reject(handle, ['the goal is not signed with the fleet key'])
         try:
             problem, text, name = self.problem_of(goal)
         except ProblemError as error:
@@ -379,11 +383,21 @@ class PlannerNode(Node):
     def cancel_goal(self, handle) -> CancelResponse:
         if self.goal is None or self.goal.handle.goal_id != handle.goal_id:
             return CancelResponse.REJECT
+        if self.auth.enabled:
+            # An action's cancel request carries nothing to sign: in an authenticated fleet,
+            # missions are cancelled through the signed cancel_mission service.
+            self.get_logger().warning('refusing an unsigned cancel of the RunMission goal: '
+                                      f'use the {CANCEL_MISSION_SERVICE} service')
+            return CancelResponse.REJECT
         self.carry_out(self.controller.cancel('cancelled by the RunMission client',
                                               self.wall()))
         return CancelResponse.ACCEPT
 
     def on_cancel(self, request, response):
+        if not self.auth.accept(request, CANCEL_MISSION_SERVICE, service=True):
+            response.success = False
+            response.message = 'refused: the request is not signed with the fleet key'
+            return response
         mission = self.controller.mission
         if request.mission_id and (mission is None or request.mission_id != mission.id):
             response.success = False
@@ -404,6 +418,9 @@ class PlannerNode(Node):
     def on_add_jobs(self, request, response):
         mission = self.controller.mission
         response.success = False
+        if not self.auth.accept(request, ADD_JOBS_SERVICE, service=True):
+            response.message = 'refused: the request is not signed with the fleet key'
+            return response
         if mission is None or mission.state.ended:
             response.message = 'no mission is running'
             return response
@@ -436,6 +453,8 @@ class PlannerNode(Node):
                                             self.events_sub.get_publisher_count()))
 
     def on_robot_state(self, msg: RobotState) -> None:
+        if not self.auth.accept(msg, ROBOT_STATES_TOPIC, {msg.robot}):
+            return
         mode = MODE_FROM_MSG.get(msg.mode)
         if mode is None:
             self.ignore(Ignored.UNKNOWN, f"state of robot '{shorten(msg.robot, 80)}' has "
@@ -449,12 +468,15 @@ class PlannerNode(Node):
         self.carry_out(self.controller.robot_state(report, self.wall()))
 
     def on_event(self, msg: TaskEvent) -> None:
+        if msg.kind == TaskEvent.KIND_JOB_DONE and msg.event_id in self.job_done_ids:
+            return  # its own
+        senders = {PLANNER} if msg.kind == TaskEvent.KIND_JOB_DONE else {msg.robot}
+        if not self.auth.accept(msg, TASK_EVENTS_TOPIC, senders):
+            return
         kind = EVENT_FROM_MSG.get(msg.kind)
         if kind is None:
             self.ignore(Ignored.UNKNOWN, f"event '{shorten(msg.event_id)}': kind {msg.kind} "
                                          'is not a TaskEvent kind')
-            return
-        if kind == EventKind.JOB_DONE and msg.event_id in self.job_done_ids:
             return
         event = EventReport(msg.event_id, msg.mission_id, kind, msg.robot, msg.job,
                             msg.plan_revision, msg.time)
@@ -466,6 +488,8 @@ class PlannerNode(Node):
 
     def on_plan(self, msg: Plan) -> None:
         if (msg.mission_id, msg.revision, msg.stamp) == self.last_published:
+            return
+        if not self.auth.accept(msg, PLAN_TOPIC, {PLANNER}):
             return
         current = self.controller.mission
         revision = current.tracker.revision if current is not None else 0
@@ -558,7 +582,7 @@ class PlannerNode(Node):
                            mission.id, effect.revision, start, mission.settings.time_scale,
                            stamp, effect.continued, effect.reasons)
         self.last_published = (msg.mission_id, msg.revision, msg.stamp)
-        self.plan_pub.publish(msg)
+        self.plan_pub.publish(self.auth.sign(msg, PLAN_TOPIC))
         log = self.get_logger()
         if effect.cancelled:
             log.warning(f'published plan revision {effect.revision}: mission cancelled')
@@ -584,10 +608,10 @@ class PlannerNode(Node):
         self.event_count += 1
         event_id = f'planner/{self.incarnation}/{self.event_count}'
         self.job_done_ids.add(event_id)
-        self.event_pub.publish(TaskEvent(
+        self.event_pub.publish(self.auth.sign(TaskEvent(
             stamp=self.get_clock().now().to_msg(), event_id=event_id, mission_id=mission.id,
             kind=TaskEvent.KIND_JOB_DONE, job=effect.job, plan_revision=effect.revision,
-            time=effect.time))
+            time=effect.time), TASK_EVENTS_TOPIC))
         tracker = mission.tracker
         self.get_logger().info(f'job {effect.job} done at t={effect.time:.2f} '
                                f'({len(tracker.done)}/{len(tracker.jobs)})')
@@ -596,12 +620,12 @@ class PlannerNode(Node):
         mission = self.controller.mission
         wall = self.wall()
         self.event_count += 1
-        self.story_pub.publish(MissionEvent(
+        self.story_pub.publish(self.auth.sign(MissionEvent(
             stamp=self.get_clock().now().to_msg(),
             event_id=f'planner/{self.incarnation}/{self.event_count}', mission_id=mission.id,
             kind=MISSION_EVENT_TO_MSG[note.kind], plan_revision=mission.tracker.revision,
             time=max(self.controller.now_units(wall), 0.0), robot=note.robot, job=note.job,
-            reasons=list(note.reasons)))
+            reasons=list(note.reasons)), MISSION_EVENTS_TOPIC))
         self.get_logger().info(shorten(describe(note), 2000))
 
     def publish_periodic(self) -> None:
@@ -612,10 +636,10 @@ class PlannerNode(Node):
         mission = self.controller.mission
         if mission is None or mission.tracker.plan is None:
             return
-        self.jobs_pub.publish(JobStates(stamp=self.get_clock().now().to_msg(),
-                                        mission_id=mission.id,
-                                        plan_revision=mission.tracker.revision,
-                                        jobs=job_states(mission.tracker)))
+        self.jobs_pub.publish(self.auth.sign(JobStates(
+            stamp=self.get_clock().now().to_msg(), mission_id=mission.id,
+            plan_revision=mission.tracker.revision, jobs=job_states(mission.tracker)),
+            JOB_STATES_TOPIC))
 
     def publish_feedback(self) -> None:
         view = self.controller.status(self.wall())
@@ -635,7 +659,7 @@ class PlannerNode(Node):
             return
         self.publish_feedback()
         ignored = view.ignored
-        self.status_pub.publish(MissionStatus(
+        self.status_pub.publish(self.auth.sign(MissionStatus(
             stamp=self.get_clock().now().to_msg(), mission_id=view.mission_id,
             state=STATE_TO_MSG[view.state], plan_revision=view.revision,
             scenario_id=view.scenario, jobs_done=view.jobs_done,
@@ -645,7 +669,8 @@ class PlannerNode(Node):
             blocked_reasons=list(view.blocked), replan_reasons=list(view.replan_reasons),
             warnings=list(view.warnings), ignored_stale=ignored[Ignored.STALE],
             ignored_duplicate=ignored[Ignored.DUPLICATE],
-            ignored_unknown=ignored[Ignored.UNKNOWN]))
+            ignored_unknown=ignored[Ignored.UNKNOWN],
+            ignored_unauthenticated=self.auth.rejected), MISSION_STATUS_TOPIC))
 
     def destroy_node(self):
         self.pool.shutdown(wait=False, cancel_futures=True)

@@ -1,0 +1,214 @@
+"""Who may direct the fleet: messages signed with a fleet key (see docs/security.md).
+
+The Fast DDS shipped as PyPI wheels has no security plugins, so SROS2 cannot be used; this is
+authentication at the application level. Every node of a fleet reads the same secret key
+(`fleet_key_file`); senders put an `fjsp_msgs/Auth` in each message — their name, their
+process incarnation, a counter — and an HMAC-SHA256 over the resolved topic (or service) name
+and the message's content (every field, in definition order) with the MAC left empty.
+Receivers drop, count and warn about (once per sender and reason) what does not verify: no
+MAC, a wrong MAC, a sender that may not say this (a robot reporting for another robot, anyone
+but the planner publishing plans or job completions), or a counter that does not increase
+(a replay).
+
+Without a key nothing is signed or checked, and every node says so when it starts.
+"""
+
+import hashlib
+import hmac
+import json
+import numbers
+import os
+import secrets
+import stat
+import time
+from collections import Counter
+from pathlib import Path
+
+from fjsp_common.running import ParameterError, declare, shorten
+from fjsp_msgs.msg import Auth
+
+KEY_BYTES = 32
+KEY_FILE_VARIABLE = 'FJSP_FLEET_KEY_FILE'
+"""Where command-line tools and scripts find the fleet key when not told otherwise."""
+PLANNER = 'planner'
+"""The sender name of the fleet's planner: the only one whose plans and verdicts count."""
+
+
+class FleetKeyError(ValueError):
+    """A fleet key file that cannot be used; the message names the file and why."""
+
+
+def read_key(path) -> bytes:
+    """The fleet key in `path`: hex text of at least 32 bytes (what `new_key` writes)."""
+    path = Path(path).expanduser()
+    try:
+        text = path.read_text().strip()
+    except (OSError, UnicodeDecodeError) as error:
+        raise FleetKeyError(f'{path}: cannot read the fleet key: {error}') from None
+    try:
+        key = bytes.fromhex(text)
+    except ValueError:
+        raise FleetKeyError(f'{path}: a fleet key is hex text, {2 * KEY_BYTES} digits or more'
+                        ) from None
+    if len(key) < KEY_BYTES:
+        raise FleetKeyError(f'{path}: the fleet key has {len(key)} bytes; at least {KEY_BYTES} '
+                        'are needed')
+    return key
+
+
+def new_key(path) -> Path:
+    """Write a fresh random fleet key to `path`, readable by its owner only."""
+    path = Path(path).expanduser()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    descriptor = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
+    with os.fdopen(descriptor, 'w') as f:
+        f.write(secrets.token_hex(KEY_BYTES) + '\n')
+    os.chmod(path, stat.S_IRUSR | stat.S_IWUSR)
+    return path
+
+
+def _digest(key: bytes, name: str, msg) -> bytes:
+    mac, msg.auth.mac = msg.auth.mac, []
+    try:
+        data = json.dumps(_canonical(msg), separators=(',', ':')).encode()
+    finally:
+        msg.auth.mac = mac
+    return hmac.new(key, name.encode() + b'\0' + data, hashlib.sha256).digest()
+
+
+def _canonical(value):
+    """The message's content, field by field in definition order, floats exact. Not its CDR
+    serialization: that carries whatever happened to be in memory in its padding bytes, so
+    the same message serializes differently from one call to the next."""
+    if hasattr(value, 'get_fields_and_field_types'):
+        return [_canonical(getattr(value, field)) for field in value.get_fields_and_field_types()]
+    if isinstance(value, bool | str):
+        return value
+    if isinstance(value, numbers.Integral):
+        return int(value)
+    if isinstance(value, numbers.Real):
+        return float(value).hex()
+    if isinstance(value, bytes):
+        return value.hex()
+    return [_canonical(item) for item in value]
+
+
+def client_signer(key_file, sender: str) -> 'Signer':
+    """The signer of a tool or script: the key in `key_file`, else in the file named by
+    $FJSP_FLEET_KEY_FILE, else none (unsigned requests, for an unauthenticated fleet)."""
+    path = key_file or os.environ.get(KEY_FILE_VARIABLE) or None
+    return Signer(read_key(path) if path else None, sender)
+
+
+class Signer:
+    """Signs what one process sends as `sender`."""
+
+    def __init__(self, key: bytes | None, sender: str):
+        self.key = key
+        self.sender = sender
+        self.incarnation = time.time_ns()
+        self._counters = Counter()
+
+    def sign(self, msg, name: str):
+        """`msg` with its `auth` filled for resolved topic or service `name`; unchanged
+        without a key."""
+        if self.key is None:
+            return msg
+        self._counters[name] += 1
+        msg.auth = Auth(sender=self.sender, incarnation=self.incarnation,
+                        counter=self._counters[name], mac=[])
+        msg.auth.mac = list(_digest(self.key, name, msg))
+        return msg
+
+
+class Verifier:
+    """Checks what one process receives; remembers the latest (incarnation, counter) of each
+    sender on each name, so a replayed message is refused."""
+
+    def __init__(self, key: bytes | None):
+        self.key = key
+        self.rejected = 0
+        self._latest: dict[tuple[str, str], tuple[int, int]] = {}
+
+    def check(self, msg, name: str, senders=None) -> str:
+        """Why `msg`, received on resolved `name`, must be dropped ('' if it verifies).
+        `senders`, if given, are the only sender names that may say it."""
+        if self.key is None:
+            return ''
+        why = self._why(msg, name, senders)
+        if why:
+            self.rejected += 1
+        return why
+
+    def _why(self, msg, name, senders) -> str:
+        auth = msg.auth
+        if not auth.mac:
+            return 'not signed'
+        if not hmac.compare_digest(bytes(auth.mac), _digest(self.key, name, msg)):
+            return f"signature of '{auth.sender[:80]}' does not verify with the fleet key"
+        if senders is not None and auth.sender not in senders:
+            return f"'{auth.sender[:80]}' may not send this"
+        stamp = (auth.incarnation, auth.counter)
+        latest = self._latest.get((name, auth.sender))
+        if latest is not None and stamp <= latest:
+            return f"replayed message of '{auth.sender[:80]}' (counter {auth.counter})"
+        self._latest[name, auth.sender] = stamp
+        return ''
+
+
+class NodeAuth:
+    """A node's signing and checking, with its `fleet_key_file` parameter: names resolved as
+    the node resolves them, and one warning per sender and reason for what is dropped."""
+
+    def __init__(self, node, sender: str):
+        self.node = node
+        path = declare(node, 'fleet_key_file', '',
+                       'file holding the fleet key (hex); empty: unauthenticated')
+        key = None
+        if path:
+            try:
+                key = read_key(path)
+            except FleetKeyError as error:
+                raise ParameterError(f"parameter 'fleet_key_file': {error}") from None
+            node.get_logger().info(f'authenticated fleet: messages signed and checked with '
+                                   f'the key in {path}')
+        else:
+            node.get_logger().warning(
+                'unauthenticated: no fleet key (parameter fleet_key_file), so any node on this '
+                'ROS domain can send plans, reports and faults that this node believes')
+        self.signer = Signer(key, sender)
+        self.verifier = Verifier(key)
+        self._names: dict[str, str] = {}
+        self._warned: set[tuple[str, str, str]] = set()
+
+    @property
+    def enabled(self) -> bool:
+        return self.verifier.key is not None
+
+    @property
+    def rejected(self) -> int:
+        return self.verifier.rejected
+
+    def resolve(self, name: str, service: bool = False) -> str:
+        if name not in self._names:
+            resolve = self.node.resolve_service_name if service else \
+                self.node.resolve_topic_name
+            self._names[name] = resolve(name)
+        return self._names[name]
+
+    def sign(self, msg, name: str, service: bool = False):
+        return self.signer.sign(msg, self.resolve(name, service))
+
+    def accept(self, msg, name: str, senders=None, service: bool = False) -> bool:
+        """Whether `msg` received on `name` verifies; if not, it is counted and warned about
+        once per sender and reason."""
+        why = self.verifier.check(msg, self.resolve(name, service), senders)
+        if not why:
+            return True
+        kind = why.split(':')[0].split("'")[0]
+        key = (name, shorten(msg.auth.sender, 80), kind)
+        if key not in self._warned:
+            self._warned.add(key)
+            self.node.get_logger().warning(f'dropping an unauthenticated message on {name} '
+                                           f'({why}); further ones like it are only counted')
+        return False
