@@ -14,6 +14,11 @@ from harness import SCENARIO
       '-p', 'time_scale:=-1.0'], 2, "parameter 'time_scale' must be"),  # negative scale
     (['run', 'fjsp_planner', 'planner_node', '--ros-args', '-p', 'workers:=two'],
      2, "parameter 'workers' must be of type integer"),  # wrong parameter type
+    *[(['run', 'fjsp_planner', 'planner_node', '--ros-args', '-p', f'scenario:={SCENARIO}',
+        '-p', f'{name}:={value}'], 2, f"parameter '{name}' must be within")
+      for name, value in (('time_scale', '.inf'), ('robot_wait_timeout', '.nan'),
+                          ('start_delay', '1e300'), ('workers', '999999'),
+                          ('status_period', '1e-9'), ('panels', '100000'))],
     (['run', 'robot_agents', 'marc_agent'], 2, "parameter 'robot_name' is required"),
     (['run', 'robot_agents', 'lsms_agent', '--ros-args', '-p', 'robot_name:=LSMS',
       '-p', 'tick_period:=0.0'], 2, "parameter 'tick_period' must be within [0.001, 1]"),

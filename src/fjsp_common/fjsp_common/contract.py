@@ -57,6 +57,16 @@ EVENTS_QOS = QoSProfile(
 joiners (a restarted planner rebuilds a mission from the agents' histories)."""
 
 
+FAULT_REQUESTS_QOS = QoSProfile(
+    reliability=ReliabilityPolicy.RELIABLE,
+    durability=DurabilityPolicy.VOLATILE,
+    history=HistoryPolicy.KEEP_LAST,
+    depth=256,
+)
+"""An agent's fault service queues this many requests; the default (10) dropped most of a
+burst of 40, leaving their callers waiting out their timeouts."""
+
+
 def _pair(vocabulary, message, prefix: str) -> tuple[dict, dict]:
     to_msg = {word: getattr(message, f'{prefix}_{word.name}') for word in vocabulary}
     constants = {getattr(message, name) for name in dir(message) if name.startswith(f'{prefix}_')}

@@ -23,9 +23,13 @@ import math
 import os
 import sys
 import threading
+import time
+import uuid
 from contextlib import contextmanager
 
 FAULTS = ('fail', 'recover', 'delay')
+RESEND = 1.0
+"""Seconds without an answer after which a fault request is sent again."""
 
 
 class FaultError(ValueError):
@@ -120,17 +124,32 @@ def _call(node, robot, fault, factor, timeout, key_file) -> str:
             signer = client_signer(key_file, f'inject_fault/{node.get_name()}')
         except FleetKeyError as error:
             raise FaultError(str(error)) from None
-        signer.sign(request, name)
-        future = client.call_async(request)
-        if not _wait(node, future, timeout):
-            client.remove_pending_request(future)
+        request.request_id = f'{node.get_name()}/{uuid.uuid4().hex}'
+        response = _answer(node, client, request, signer, name, timeout)
+        if response is None:
             raise FaultError(f"'{name}' did not answer within {timeout:g} s")
-        response = future.result()
     finally:
         node.destroy_client(client)
     if not response.success:
         raise FaultError(response.message)
     return response.message
+
+
+def _answer(node, client, request, signer, name, timeout):
+    """The agent's answer, or None after `timeout`. A fresh client's first answer can be lost
+    (the agent may answer before it has discovered where to), so the request is resent every
+    RESEND seconds; its id makes the agent answer a resent request without applying it again.
+    """
+    deadline = time.monotonic() + timeout
+    while True:
+        signer.sign(request, name)
+        future = client.call_async(request)
+        left = deadline - time.monotonic()
+        if _wait(node, future, min(RESEND, max(left, 0.0))):
+            return future.result()
+        client.remove_pending_request(future)
+        if time.monotonic() >= deadline:
+            return None
 
 
 def _wait(node, future, timeout) -> bool:

@@ -24,6 +24,7 @@ from fjsp_common.contract import (
     EVENT_HISTORY,
     EVENT_TO_MSG,
     EVENTS_QOS,
+    FAULT_REQUESTS_QOS,
     INJECT_FAULT_SERVICE,
     LATCHED_QOS,
     MODE_TO_MSG,
@@ -37,6 +38,7 @@ from fjsp_msgs.msg import Plan, RobotState, TaskEvent
 from fjsp_msgs.srv import InjectFault
 from robot_agents.execution import FaultResult, RobotExecution, Task
 
+ANSWERS_KEPT = 1024
 NAME_LOOKUP_NODE = 'robot_agent'
 """The short-lived node that reads `robot_name` before the agent's own node can be named."""
 
@@ -77,6 +79,8 @@ class RobotAgent(Node):
         self.refusal = ''
         """Why the latest plan received is not followed ('' when it is)."""
         self.last_state = None
+        self.answered: dict[str, tuple[bool, str]] = {}
+        """The latest fault requests' answers by request id, for callers that resend."""
         self.early_events: deque[TaskEvent] = deque(maxlen=EVENT_HISTORY)
         """Reports of a mission this robot does not follow (yet): its plan may come later."""
 
@@ -86,7 +90,8 @@ class RobotAgent(Node):
         self.create_subscription(TaskEvent, TASK_EVENTS_TOPIC, self.on_event, EVENTS_QOS)
         self.fault_service = f'{self.robot}/{INJECT_FAULT_SERVICE}'
         try:
-            self.create_service(InjectFault, self.fault_service, self.on_fault)
+            self.create_service(InjectFault, self.fault_service, self.on_fault,
+                                qos_profile=FAULT_REQUESTS_QOS)
         except InvalidServiceNameException:
             raise ParameterError(f"parameter 'robot_name' must be usable in a ROS name "
                                  f'(letters, digits, underscores), got {self.robot!r}') from None
@@ -235,6 +240,9 @@ class RobotAgent(Node):
             response.message = (f"robot '{self.robot}': fault refused, the request is not "
                                 'signed with the fleet key')
             return response
+        if request.request_id and request.request_id in self.answered:
+            response.success, response.message = self.answered[request.request_id]
+            return response
         now = self.now_units()
         # Before the first plan nothing runs, so the time of a fault does not matter.
         now = 0.0 if now is None else max(now, 0.0)
@@ -257,6 +265,10 @@ class RobotAgent(Node):
         else:
             self.get_logger().warning(result.message)
         response.success, response.message = result.accepted, result.message
+        if request.request_id:
+            self.answered[request.request_id[:100]] = (result.accepted, result.message)
+            while len(self.answered) > ANSWERS_KEPT:
+                self.answered.pop(next(iter(self.answered)))
         return response
 
     # --- stepping and reporting --------------------------------------------------------

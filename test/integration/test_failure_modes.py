@@ -1,0 +1,90 @@
+"""Failure modes found under attack, over real processes: each of these hung a mission, lost a
+request or redid work before it was fixed."""
+
+import threading
+import time
+
+from harness import ROBOTS
+
+from fjsp_msgs.msg import MissionStatus, TaskEvent
+from fjsp_planner.faults import FaultError, inject_fault
+
+
+def start(launcher, observer, **planner):
+    launcher.start_planner(time_scale=0.15, **planner)
+    for robot, _ in ROBOTS:
+        launcher.start_agent(robot)
+    observer.wait_for(lambda o: o.status is not None and o.status.jobs_done >= 2, 40,
+                      'the mission under way')
+
+
+def test_a_burst_of_fault_requests_is_answered_every_one(launcher, observer):
+    launcher.start_agent('LSMS')
+    observer.wait_for(lambda o: 'LSMS' in o.robots, 20, 'the LSMS agent')
+    answers, errors = [], []
+
+    def call():
+        try:
+            answers.append(inject_fault('LSMS', 'delay', 1.5, node=observer.node, timeout=20))
+        except FaultError as error:
+            errors.append(str(error))
+
+    threads = [threading.Thread(target=call) for _ in range(40)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join(timeout=60)
+    # No plan, so every one is refused (nothing to slow down): but every one is answered.
+    assert len(answers) + len(errors) == 40
+    assert all('has no operation left to do' in e for e in errors), set(errors)
+
+
+def test_failure_and_recovery_at_once_do_not_hang_the_mission(launcher, observer):
+    start(launcher, observer)
+    revision = observer.status.plan_revision
+    inject_fault('MARC1', 'fail', node=observer.node)
+    inject_fault('MARC1', 'recover', node=observer.node)
+    observer.wait_for(lambda o: o.status.plan_revision > revision, 15,
+                      'a re-plan giving the recovered MARC1 its tasks again')
+    observer.wait_for(lambda o: o.complete(), 60, 'the mission to complete')
+    assert any('failed and recovered' in r or "'MARC1'" in r
+               for p in observer.plans for r in p.reasons)
+
+
+def test_a_restarted_agent_is_believed(launcher, observer):
+    """Its event ids must not repeat its previous process's, or its facts are dropped as
+    duplicates and the mission stalls."""
+    launcher.start_planner(time_scale=0.5, start_delay=1.0)
+    for robot, _ in ROBOTS:
+        launcher.start_agent(robot)
+    # Killed on its first job, the LSMS's next process redoes it from scratch.
+    observer.wait_for(lambda o: 'LSMS' in o.robots and o.robots['LSMS'].current_job == 'M1',
+                      40, 'the LSMS on its first job')
+    launcher.kill('lsms_agent')
+    launcher.start_agent('LSMS')
+    observer.wait_for(lambda o: o.complete(), 90, 'the mission to complete')
+    ids = [e.event_id for e in observer.events if e.robot == 'LSMS']
+    assert len(ids) == len(set(ids))
+
+
+def test_a_restarted_agent_does_not_flap(launcher, observer):
+    start(launcher, observer, heartbeat_timeout=1.0)
+    launcher.kill('lsms_agent')
+    observer.wait_for(lambda o: "robot 'LSMS' offline" in ' '.join(o.status.blocked_reasons
+                                                                  + o.status.warnings), 15,
+                      'LSMS declared offline')
+    launcher.start_agent('LSMS')
+    observer.wait_for(lambda o: o.complete(), 90, 'the mission to complete')
+    # Out once, back once: each a revision at most, not a string of them.
+    assert observer.status.plan_revision <= 4, [p.reasons for p in observer.plans]
+
+
+def test_no_robot_is_declared_offline_in_a_quiet_mission(launcher, observer):
+    start(launcher, observer)
+    observer.wait_for(lambda o: o.complete(), 60, 'the mission to complete')
+    time.sleep(2.0)
+    assert 'offline' not in launcher.log('planner')
+    assert observer.status.state == MissionStatus.STATE_COMPLETE
+    assert observer.status.plan_revision == 1
+    done = [e for e in observer.events if e.kind == TaskEvent.KIND_JOB_DONE]
+    assert len(done) == 12
