@@ -25,9 +25,12 @@ import math
 import sys
 import threading
 import time
+import uuid
 from dataclasses import dataclass
 from pathlib import Path
 
+RESEND = 1.0
+"""Seconds without an answer after which a request is sent again."""
 RESULT_STATES = ('complete', 'cancelled', 'failed', 'blocked too long', 'rejected')
 """RunMission.Result.STATE_* in order."""
 
@@ -270,15 +273,23 @@ class MissionClient:
         return self._status
 
     def _call(self, client, request, timeout):
-        self._signer.sign(request, self._node.resolve_service_name(client.srv_name))
+        """The planner's answer. The request is resent every RESEND seconds until answered
+        (a fresh client's first answer can be lost); its id makes the planner answer a resent
+        request without doing it twice."""
+        name = self._node.resolve_service_name(client.srv_name)
         if not client.wait_for_service(timeout_sec=timeout):
-            raise MissionError(f"no planner serves '{client.srv_name}' (waited {timeout:g} s)"
-                               ': is the planner running, with the same ROS_DOMAIN_ID?')
-        future = client.call_async(request)
-        if not self._wait(future, timeout):
+            raise MissionError(f"no planner serves '{name}' (waited {timeout:g} s): is the "
+                               'planner running, with the same ROS_DOMAIN_ID?')
+        request.request_id = f'{self._node.get_name()}/{uuid.uuid4().hex}'
+        deadline = time.monotonic() + timeout
+        while True:
+            self._signer.sign(request, name)
+            future = client.call_async(request)
+            if self._wait(future, min(RESEND, max(deadline - time.monotonic(), 0.0))):
+                return future.result()
             client.remove_pending_request(future)
-            raise MissionError(f"'{client.srv_name}' did not answer within {timeout:g} s")
-        return future.result()
+            if time.monotonic() >= deadline:
+                raise MissionError(f"'{name}' did not answer within {timeout:g} s")
 
 
 def _result(msg) -> MissionResult:

@@ -72,6 +72,9 @@ from fjsp_planner.core.solve import SOLVERS, solve
 from fjsp_planner.core.tracking import Ignored
 from fjsp_planner.nodes.conversions import cancel_msg, job_states, plan_msg
 
+ANSWERS_KEPT = 256
+"""Answers kept per service for requests that are resent."""
+
 RUNTIME_PARAMETERS = ('time_limit', 'replan_time_limit', 'workers', 'heartbeat_timeout',
                       'delay_threshold', 'robot_wait_timeout')
 """Honoured when set at run time (read at each use); every other parameter is read-only."""
@@ -208,8 +211,9 @@ class PlannerNode(Node):
         ActionServer(self, RunMission, RUN_MISSION_ACTION, self.execute_goal,
                      goal_callback=lambda _: GoalResponse.ACCEPT,
                      cancel_callback=self.cancel_goal)
-        self.create_service(AddJobs, ADD_JOBS_SERVICE, self.on_add_jobs)
-        self.create_service(CancelMission, CANCEL_MISSION_SERVICE, self.on_cancel)
+        self.create_service(AddJobs, ADD_JOBS_SERVICE, self.answer_once(self.on_add_jobs))
+        self.create_service(CancelMission, CANCEL_MISSION_SERVICE,
+                            self.answer_once(self.on_cancel))
 
         resumed = self.resume_unfinished()
         if problem is None:
@@ -392,6 +396,24 @@ class PlannerNode(Node):
         self.carry_out(self.controller.cancel('cancelled by the RunMission client',
                                               self.wall()))
         return CancelResponse.ACCEPT
+
+    def answer_once(self, handle):
+        """`handle` for a service whose callers resend a request until they get its answer
+        (a fresh client's first answer can be lost): a request id seen before gets the answer
+        it got then, and nothing is done twice."""
+        answers: dict[str, object] = {}
+
+        def answer(request, response):
+            if request.request_id in answers:
+                return answers[request.request_id]
+            response = handle(request, response)
+            if request.request_id:
+                answers[request.request_id[:100]] = response
+                while len(answers) > ANSWERS_KEPT:
+                    answers.pop(next(iter(answers)))
+            return response
+
+        return answer
 
     def on_cancel(self, request, response):
         if not self.auth.accept(request, CANCEL_MISSION_SERVICE, service=True):
