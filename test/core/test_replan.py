@@ -1,4 +1,5 @@
-"""Re-planning after a failure (SPEC §2), on an instance small enough to re-plan on paper.
+"""Re-planning after a failure (docs/model.md, "Re-planning"), on an instance small enough
+to re-plan on paper.
 
     locations p, q at distance 4; type 2 is locomote; every robot is an Arm of speed 1
     (hold 2, weld 3, travel = distance) starting at p at time 0

@@ -4,13 +4,13 @@ Format: the first line is `n m [average machines per operation]`; then one line 
 the number of operations, then for each operation `k` followed by `k` pairs
 `machine time` (machines numbered from 1).
 
-The classic FJSP is the special case of SPEC §1 where every job of the benchmark is a chain
-of single-robot operations. Each benchmark operation therefore becomes one job of ours
-(`J2.O3` is operation 3 of job 2, both 1-indexed) with a single one-operation plan whose
-operation type belongs to that operation alone; each machine becomes a robot `M<i>` of its
-own robot type, whose efficiency for an operation type is the machine's processing time.
-The operations of a benchmark job are chained by precedence arcs. Everything happens at one
-location and travel is free (`locomote=None`).
+The classic FJSP is the special case of our model (docs/model.md) where every job of the
+benchmark is a chain of single-robot operations. Each benchmark operation therefore becomes
+one job of ours (`J2.O3` is operation 3 of job 2, both 1-indexed) with a single
+one-operation plan whose operation type belongs to that operation alone; each machine
+becomes a robot `M<i>` of its own robot type, whose efficiency for an operation type is the
+machine's processing time. The operations of a benchmark job are chained by precedence
+arcs. Everything happens at one location and travel is free (`locomote=None`).
 """
 
 from fractions import Fraction

@@ -1,4 +1,4 @@
-"""The scheduling problem of SPEC §1: plain, immutable data checked at construction.
+"""The scheduling problem of docs/model.md: plain, immutable data checked at construction.
 
 Times are exact `Fraction`s: travel times such as distance * 10/3 must not be rounded
 before a solver decides how to put them on its own grid.
@@ -65,8 +65,9 @@ class Problem:
     """(robot, operation type) -> time, replacing the robot type's efficiency."""
     fixed: Mapping[str, FixedJob] = field(default_factory=dict)
     panels: tuple[tuple[str, ...], ...] = ()
-    """Identical copies of one job set (SPEC §1.2), job k of each copy matching; solvers
-    may use this to break the symmetry between copies and to bound moves between them."""
+    """Identical copies of one job set (docs/model.md, "Several panels"), job k of each
+    copy matching; solvers may use this to break the symmetry between copies and to bound
+    moves between them."""
     name: str = 'problem'
 
     def __post_init__(self):

@@ -1,4 +1,4 @@
-"""Re-planning after off-nominal events (SPEC §2): the problem that remains, and its solution.
+"""Re-planning after off-nominal events (docs/model.md, "Re-planning"): what remains, solved.
 
 A failure turns the executing mission into a smaller problem posed at `now`:
 

@@ -1,4 +1,5 @@
-"""YAML scenarios (format: docs/scenario-format.md) and the N-panel repetition of SPEC §1.2."""
+"""YAML scenarios (format: docs/scenario-format.md) and the N-panel repetition of
+docs/model.md ("Several panels")."""
 
 from fractions import Fraction
 from pathlib import Path
