@@ -182,8 +182,8 @@ def test_two_failures_block_with_the_reason(small):
     assert residual.problem is None and not residual.complete
     assert residual.aborted == ['J', 'P']
     assert residual.blocked == [
-        "job 'W' cannot be staffed: plan 0 [0, 1] needs 2 distinct robots able to do "
-        '[0, 1]; 1 healthy can (failed: A, B)']
+        "job 'W' cannot be staffed: plan 0 ['hold' (0), 'weld' (1)] needs 2 distinct robots "
+        "able to do ['hold' (0), 'weld' (1)]; 1 healthy can (failed: A, B)"]
 
 
 def test_recovered_robot_unblocks(small):
@@ -335,9 +335,10 @@ def test_paper_two_failures_block_then_recovery_unblocks(paper):
     state = simulated_state(problem, plan, Fraction(1), {'MARC1', 'MARC2'})
     result = replan(problem, plan, state)
     assert result.result is None
+    needs = "['hold frame link' (0) x2, 'weld connection point' (2)]"
     assert result.residual.blocked == [
-        f"job '{job}' cannot be staffed: plan 0 [0, 0, 2] needs 3 distinct robots able to "
-        'do [0, 0, 2]; 2 healthy can (failed: MARC1, MARC2)' for job in ('Aa', 'Ab')]
+        f"job '{job}' cannot be staffed: plan 0 {needs} needs 3 distinct robots able to "
+        f'do {needs}; 2 healthy can (failed: MARC1, MARC2)' for job in ('Aa', 'Ab')]
     marc1 = state.robots['MARC1']
     back = replace(state, robots={**state.robots, 'MARC1': replace(marc1, healthy=True)})
     check_replan(problem, plan, back)

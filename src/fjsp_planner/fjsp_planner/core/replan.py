@@ -283,16 +283,17 @@ def _staffing_problems(problem, todo, healthy, kept, failed) -> list[str]:
             rest = Counter(plan)
             rest.subtract(holders.values())
             if min(rest.values(), default=0) < 0:
-                shortfalls.append(f'plan {index} {sorted(plan)} has no place for the '
-                                  f'holders {_named(holders)}')
+                shortfalls.append(f'plan {index} {problem.plan_label(plan)} has no place for '
+                                  f'the holders {_named(holders)}')
                 continue
             rest_plan = list(rest.elements())
             staffed = max_staffed(problem, rest_plan, others)
             if staffed < len(rest_plan):
                 held = f' besides the holders {_named(holders)}' if holders else ''
-                shortfalls.append(f'plan {index} {sorted(plan)} needs {len(rest_plan)} '
-                                  f'distinct robots able to do {sorted(rest_plan)}{held}; '
-                                  f'{staffed} healthy can')
+                shortfalls.append(f'plan {index} {problem.plan_label(plan)} needs '
+                                  f'{len(rest_plan)} distinct robots able to do '
+                                  f'{problem.plan_label(rest_plan)}{held}; {staffed} healthy '
+                                  'can')
         if len(shortfalls) == len(job.plans):
             problems.append(f"job '{job.name}' cannot be staffed: " + '; '.join(shortfalls)
                             + why_short)
