@@ -26,6 +26,11 @@ import threading
 from contextlib import contextmanager
 
 FAULTS = ('fail', 'recover', 'delay')
+# The agent's bounds (robot_agents.execution, which refuses beyond them also for the product
+# of several delays on one operation): refused here before anything is sent.
+MIN_DELAY_FACTOR = 1e-3
+MAX_DELAY_FACTOR = 1e3
+BOUNDS = f'within [{MIN_DELAY_FACTOR:g}, {MAX_DELAY_FACTOR:g}]'
 
 
 class FaultError(ValueError):
@@ -42,13 +47,14 @@ def check_fault(fault: str, factor: float | None) -> float:
                              "'delay' does")
         return 0.0
     if factor is None:
-        raise FaultError("fault 'delay' needs a factor > 0 (e.g. 2 to double durations)")
+        raise FaultError(f"fault 'delay' needs a factor {BOUNDS} (e.g. 2 to double "
+                         'durations)')
     try:
         factor = float(factor)
     except (TypeError, ValueError):
         raise FaultError(f"fault 'delay': factor must be a number, got {factor!r}") from None
-    if not (math.isfinite(factor) and factor > 0):
-        raise FaultError(f"fault 'delay': factor must be a finite number > 0, got {factor:g}")
+    if not MIN_DELAY_FACTOR <= factor <= MAX_DELAY_FACTOR:    # NaN fails both comparisons
+        raise FaultError(f"fault 'delay': factor must be {BOUNDS}, got {factor:g}")
     return factor
 
 
@@ -160,7 +166,7 @@ def main(argv=None) -> int:
     parser.add_argument('fault', choices=FAULTS)
     parser.add_argument('--factor', type=float,
                         help="delay only: multiply the current (or next) operation's "
-                             'duration by F (> 0)')
+                             f'duration by F ({BOUNDS})')
     parser.add_argument('--timeout', type=float, default=5.0, metavar='S',
                         help='seconds to wait for the agent to appear, and then to answer '
                              '(default 5)')
