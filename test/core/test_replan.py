@@ -119,6 +119,30 @@ def test_failure_while_holding_voids_the_jig_job(small):
     assert ('J', 'W', 0) in p.holding
 
 
+def test_holder_that_failed_and_came_back_voids_the_jig_job(small):
+    """A failed at 9/4 while holding and was back by 5/2: what it held was let go, so J is
+    redone as if A were still out, although A may redo it."""
+    state = at(small, Fraction(5, 2))
+    a = state.robots['A']
+    back = replace(state, robots={**state.robots, 'A': replace(a, last_failure=Fraction(9, 4))})
+    residual = residual_problem(small, back, PLAN)
+    assert residual.voided == ['J'] and residual.kept == [] and residual.failed == []
+    assert 'A' in {r.name for r in residual.problem.robots}
+
+
+@pytest.mark.parametrize(('failed_at', 'started', 'voided'), [
+    (Fraction(-1), {}, []),                      # before the planned start of J (0)
+    (Fraction(0), {}, ['J']),                    # as J began
+    (Fraction(1, 2), {}, ['J']),                 # after J's planned start...
+    (Fraction(1, 2), {'J': Fraction(1)}, []),    # ...but before it actually began
+])
+def test_only_a_failure_since_the_jig_job_began_voids_it(small, failed_at, started, voided):
+    state = at(small, Fraction(5, 2))
+    robots = {**state.robots, 'A': replace(state.robots['A'], last_failure=failed_at)}
+    residual = residual_problem(small, replace(state, robots=robots, started=started), PLAN)
+    assert residual.voided == voided
+
+
 def test_healthy_holder_keeps_holding(small):
     """C fails at 5/2 while A holds since J: J stays, fixed with its holder only, so that the
     holding arc still sends A directly to W."""
