@@ -177,7 +177,7 @@ class MissionTracker:
         if robot in facts[kind] or record.end is not None:
             self.ignored[Ignored.DUPLICATE] += 1
             return Outcome(Ignored.DUPLICATE, f"'{robot}' already reported {kind} for job "
-                                              f"'{job}' (event '{event_id}')")
+                                              f"'{job}' (event {shown(event_id)})")
         facts[kind][robot] = time
         if kind == EventKind.OPERATION_DONE:
             robots = self.plan.jobs[job].robots
@@ -192,46 +192,47 @@ class MissionTracker:
     def _check_event(self, event_id, kind, robot, job, revision, time) -> Outcome | None:
         if not isinstance(event_id, str):
             return Outcome(Ignored.UNKNOWN, f'invalid event id {shown(event_id)}')
+        what = f'event {shown(event_id)}'      # an id of a megabyte is not logged whole
         if self.plan is None:
-            return Outcome(Ignored.STALE, f"event '{event_id}' arrived before any plan")
+            return Outcome(Ignored.STALE, f'{what} arrived before any plan')
         if event_id in self._event_ids:
-            return Outcome(Ignored.DUPLICATE, f"event '{event_id}' was already received")
+            return Outcome(Ignored.DUPLICATE, f'{what} was already received')
         if not isinstance(kind, str) or kind not in set(EventKind):
-            return Outcome(Ignored.UNKNOWN, f"event '{event_id}' has unknown event kind "
+            return Outcome(Ignored.UNKNOWN, f'{what} has unknown event kind '
                                             f'{shown(kind)}')
         if not isinstance(robot, str) or robot not in self.robots:
-            return Outcome(Ignored.UNKNOWN, f"event '{event_id}' names unknown robot "
+            return Outcome(Ignored.UNKNOWN, f'{what} names unknown robot '
                                             f'{shown(robot)}')
         if not isinstance(job, str) or job not in self.jobs:
-            return Outcome(Ignored.UNKNOWN, f"event '{event_id}' names unknown job "
+            return Outcome(Ignored.UNKNOWN, f'{what} names unknown job '
                                             f'{shown(job)}')
         if isinstance(revision, bool) or not isinstance(revision, int):
-            return Outcome(Ignored.UNKNOWN, f"event '{event_id}' has invalid plan revision "
+            return Outcome(Ignored.UNKNOWN, f'{what} has invalid plan revision '
                                             f'{shown(revision)}')
         if revision > self.revision:
-            return Outcome(Ignored.UNKNOWN, f"event '{event_id}' follows plan revision "
+            return Outcome(Ignored.UNKNOWN, f'{what} follows plan revision '
                                             f'{revision}, which was never published '
                                             f'(current: {self.revision})')
         if revision < self.jobs[job].since_revision:
-            return Outcome(Ignored.STALE, f"event '{event_id}' follows plan revision "
+            return Outcome(Ignored.STALE, f"{what} follows plan revision "
                                           f"{revision}; revision "
                                           f'{self.jobs[job].since_revision} started '
                                           f"'{job}' afresh")
         if self.jobs[job].aborted:
-            return Outcome(Ignored.STALE, f"event '{event_id}': job '{job}' was aborted and "
+            return Outcome(Ignored.STALE, f"{what}: job '{job}' was aborted and "
                                           'waits for a new revision to be redone')
         if job not in self.plan.jobs:
-            return Outcome(Ignored.STALE, f"event '{event_id}': job '{job}' is not in plan "
+            return Outcome(Ignored.STALE, f"{what}: job '{job}' is not in plan "
                                           f'revision {self.revision}, it was done before')
         if robot not in self.plan.jobs[job].robots:
             if revision < self.revision:
-                return Outcome(Ignored.STALE, f"event '{event_id}' follows plan revision "
+                return Outcome(Ignored.STALE, f"{what} follows plan revision "
                                               f'{revision}; in revision {self.revision} '
                                               f"'{robot}' has no part in job '{job}'")
-            return Outcome(Ignored.UNKNOWN, f"event '{event_id}': robot '{robot}' has no "
+            return Outcome(Ignored.UNKNOWN, f"{what}: robot '{robot}' has no "
                                             f"part in job '{job}'")
         if not _time_ok(time):
-            return Outcome(Ignored.UNKNOWN, f"event '{event_id}' has invalid time "
+            return Outcome(Ignored.UNKNOWN, f'{what} has invalid time '
                                             f'{shown(time)}')
         return None
 
@@ -241,13 +242,14 @@ class MissionTracker:
         planner arriving after this one's first plan, can break this)."""
         if kind != EventKind.OPERATION_DONE:
             return None
+        what = f'event {shown(event_id)}'
         started = self.jobs[job].started.get(robot)
         if started is None:
-            return Outcome(Ignored.UNKNOWN, f"event '{event_id}': '{robot}' reports "
+            return Outcome(Ignored.UNKNOWN, f"{what}: '{robot}' reports "
                                             f"operation_done for job '{job}' without having "
                                             'reported started')
         if time < started:
-            return Outcome(Ignored.UNKNOWN, f"event '{event_id}': '{robot}' reports "
+            return Outcome(Ignored.UNKNOWN, f"{what}: '{robot}' reports "
                                             f'operation_done at t={float(time):g} before it '
                                             f"started at t={float(started):g} (job '{job}')")
         return None
