@@ -53,7 +53,9 @@ def check_fault(fault: str, factor: float | None) -> float:
         factor = float(factor)
     except (TypeError, ValueError):
         raise FaultError(f"fault 'delay': factor must be a number, got {factor!r}") from None
-    if not MIN_DELAY_FACTOR <= factor <= MAX_DELAY_FACTOR:    # NaN fails both comparisons
+    if not (math.isfinite(factor) and factor > 0):
+        raise FaultError(f"fault 'delay': factor must be a finite number > 0, got {factor:g}")
+    if not MIN_DELAY_FACTOR <= factor <= MAX_DELAY_FACTOR:
         raise FaultError(f"fault 'delay': factor must be {BOUNDS}, got {factor:g}")
     return factor
 
