@@ -72,6 +72,13 @@ def test_bad_arguments_exit_2_with_a_message(args, message):
     assert 'Traceback' not in run.stderr
 
 
+@pytest.mark.parametrize('option', ['--json', '--gantt'])
+def test_an_output_that_cannot_be_written_exits_2(tmp_path, option):
+    run = fjsp_solve(PAPER, '--solver', 'greedy', option, tmp_path / 'no' / 'such' / 'out')
+    assert (run.returncode, 'Traceback' in run.stderr) == (2, False), run.stderr
+    assert run.stderr.startswith('fjsp-solve: cannot write ') and 'No such file' in run.stderr
+
+
 @pytest.mark.parametrize('old, new, message', [
     ('{name: MARC2, type: MARC, speed: 25}', '{name: MARC2, type: MARC, sped: 25}',
      "robot 'MARC2': unknown key 'sped'"),

@@ -95,7 +95,6 @@ def _plan(args) -> int:
     result = solve(problem, solver=args.solver, time_limit=args.time_limit,
                    workers=args.workers, mip_backend=args.mip_backend)
     _stage = 'writing the result'
-
     if result.schedule is not None:
         violations = validate(problem, result.schedule)
         if violations:
@@ -107,13 +106,17 @@ def _plan(args) -> int:
     print(status_line(result))
     for note in result.notes:
         print(f'note: {note}')
-    if args.json:
-        args.json.write_text(json.dumps(result_json(problem, result), indent=2) + '\n')
-    if args.gantt and result.schedule is not None:
-        from fjsp_planner.core.gantt import draw_gantt
+    try:
+        if args.json:
+            args.json.write_text(json.dumps(result_json(problem, result), indent=2) + '\n')
+        if args.gantt and result.schedule is not None:
+            from fjsp_planner.core.gantt import draw_gantt
 
-        draw_gantt(problem, result.schedule, args.gantt,
-                   title=f'{problem.name}: makespan {_number(result.makespan):g}')
+            draw_gantt(problem, result.schedule, args.gantt,
+                       title=f'{problem.name}: makespan {_number(result.makespan):g}')
+    except OSError as error:
+        print(f'fjsp-solve: cannot write {error.filename}: {error.strerror}', file=sys.stderr)
+        return EXIT_BAD_INPUT
     return 0 if result.schedule is not None else 1
 
 
