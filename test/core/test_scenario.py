@@ -227,6 +227,19 @@ def test_reading_errors_and_model_errors_come_together(paper_data):
     assert 'precedence cycle: ' in text
 
 
+def test_a_malformed_entry_hides_only_its_own_consequences(paper_data):
+    data = copy.deepcopy(paper_data)
+    data['jobs'][4]['plans'] = 5
+    data['jobs'].append({'name': 'Aa', 'plans': [[0, 0, 2]]})   # a second 'Aa': said too
+    data['distances']['table']['rows'][0][2] = 'far'
+    with pytest.raises(ProblemError) as caught:
+        parse_scenario(data)
+    assert sorted(caught.value.problems) == sorted([
+        "job 'Aa': plans must be a list of lists of operation types",
+        "job 'Aa' is defined 2 times",
+        "distance 'M1'-'Ja': expected a finite number, got 'far'"])
+
+
 def test_a_malformed_entry_is_reported_once(paper_data):
     """A job whose plans cannot be read is not also an 'unknown job' in every arc naming it."""
     data = copy.deepcopy(paper_data)

@@ -138,18 +138,30 @@ def repeat_panels(problem: Problem, panels: int, shift=DEFAULT_SHIFT) -> Problem
 class _Reader:
     """Collects every problem of a scenario mapping instead of stopping at the first.
 
-    `reported` holds the names (`"job 'Aa'"`) of entries found wrong and kept in a neutral
-    form (no plans, no efficiencies), so that what the model check then says about them is
-    not said as well: it would only be a consequence.
+    `consequences` holds what the model check would say about entries found wrong and kept
+    in a neutral form (a job without plans, a robot type without efficiencies), so that it is
+    not said as well: it would only repeat the problem already reported.
     """
 
     def __init__(self):
         self.problems = []
-        self.reported = set()
+        self.consequences = set()
 
     def report(self, item: str, message: str):
         self.problems.append(message)
-        self.reported.add(item)
+        self.explained(item)
+
+    def explained(self, item: str):
+        """What follows from `item` (`"job 'Aa'"`, `"robot 'R1'"`, `"robot type 'T'"`) being
+        kept in its neutral form."""
+        if item.startswith('job '):
+            self.consequences.update({f'{item} has no process plan', f'{item}: plan ',
+                                      f'{item} cannot be staffed',
+                                      f'but {item} has no such operation'})
+        elif item.startswith('robot type '):
+            self.consequences.add(f'{item} has no efficiency for the locomote')
+        else:
+            self.consequences.add(f'{item}: unknown robot type')
 
     def attempt(self, read, fallback, item: str | None = None):
         """`read()`, or `fallback` with its problems recorded (against `item`)."""
@@ -158,7 +170,7 @@ class _Reader:
         except ProblemError as error:
             self.problems += error.problems
             if item is not None:
-                self.reported.add(item)
+                self.explained(item)
             return fallback
 
     def number(self, value, what, low, high, default=None):
@@ -238,7 +250,7 @@ def _from_mapping(data, default_name, panels=None, shift=None):
             return by_name[ref]
         read.problems.append(f'{what}: unknown operation type {shown(ref)}')
         if item is not None:
-            read.reported.add(item)
+            read.explained(item)
         return None
 
     locomote = data.get('locomote')
@@ -284,7 +296,7 @@ def _from_mapping(data, default_name, panels=None, shift=None):
         else:
             type_name = read.name(entry['type'], f'{item} type')
             if type_name is None:
-                read.reported.add(item)
+                read.explained(item)
                 type_name = ''
         start = entry.get('start_location')
         if start is not None:
@@ -317,7 +329,7 @@ def _from_mapping(data, default_name, panels=None, shift=None):
         elif len(plans) > limits.MAX_PLANS:
             read.problems += limits.count_problem(f'{item}: plans', len(plans),
                                                   limits.MAX_PLANS)
-            read.reported.add(item)
+            read.explained(item)
         elif any(len(plan) > limits.MAX_ROBOTS for plan in plans):
             read.report(item, f'{item}: a plan has more operations than the limit of '
                               f'{limits.MAX_ROBOTS} robots could ever staff')
@@ -391,7 +403,7 @@ def _from_mapping(data, default_name, panels=None, shift=None):
             if 'name' in data else str(default_name))
     except ProblemError as error:
         read.problems += [p for p in error.problems
-                          if not any(item in p for item in read.reported)]
+                          if not any(c in p for c in read.consequences)]
     if read.problems:
         raise ProblemError(list(dict.fromkeys(read.problems)))
     return problem, file_panels
@@ -455,8 +467,10 @@ def _distance(read, distances, a, b, value, symmetric):
     value = read.attempt(lambda: limits.number(value, f"distance '{a}'-'{b}'", Fraction(0),
                                                MAX_TIME), None)
     if value is None:
-        read.reported.update({f"'{a}'-'{b}'", f"'{b}'-'{a}'", f"'{a}' and '{b}'",
-                              f"'{b}' and '{a}'"})
+        read.consequences.update({f"'{a}'-'{b}' is not symmetric",
+                                  f"'{b}'-'{a}' is not symmetric",
+                                  f"no distance between locations '{a}' and '{b}'",
+                                  f"no distance between locations '{b}' and '{a}'"})
         return
     for key in ((a, b), (b, a)) if symmetric else ((a, b),):
         if symmetric and key in distances and distances[key] != value:
