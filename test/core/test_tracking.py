@@ -221,27 +221,6 @@ def test_failure_replan_and_completion_give_a_valid_executed_timeline(planned):
     assert tracker.projected_makespan(0) == executed.makespan
 
 
-def test_a_robot_reported_on_its_next_job_has_left_the_previous_one():
-    """B finished its part of W and started X before A's OPERATION_DONE for W arrived (they
-    come from different robots): W must have completed, or B would not have left it, so the
-    state re-planning starts from has W done rather than B on two jobs at once."""
-    problem = tiny_problem()
-    plan = sched({'A': ('J', 'W'), 'B': ('W', 'X')},
-                 J=(0, 2, {'A': 0}), W=(2, 5, {'A': 0, 'B': 1}), X=(7, 10, {'B': 1}))
-    tracker = MissionTracker(problem)
-    tracker.set_plan(plan, 1)
-    execute(tracker, [('J', 0, {'A': 2})])
-    for robot in ('A', 'B'):
-        tracker.record_event(f'{robot}/W/s', EventKind.STARTED, robot, 'W', 1, 2.0)
-    tracker.record_event('B/W/d', EventKind.OPERATION_DONE, 'B', 'W', 1, 5.0)
-    tracker.record_event('B/X/s', EventKind.STARTED, 'B', 'X', 1, 7.0)
-    assert tracker.running == {'W', 'X'}
-    state = tracker.execution_state(8.0)
-    assert set(state.running) == {'X'} and 'W' in state.done
-    residual = residual_problem(problem, state, plan)
-    assert set(residual.problem.fixed) == {'X'}
-
-
 # --- no report ever raises ------------------------------------------------------------
 
 def test_operation_done_without_started_is_classified_not_a_crash(planned):
@@ -525,7 +504,7 @@ def test_violations_of_the_executed_timeline_are_named(plan, executed, violation
     assert violation in violations, violations
 
 
-def test_violations_across_revisions_and_a_completed_replanned_mission(planned):
+def test_the_paper_executed_as_planned_has_no_violations(planned):
     problem, schedule = planned
     tracker = MissionTracker(problem)
     tracker.set_plan(schedule, 1)

@@ -412,12 +412,7 @@ class MissionTracker:
         return Schedule(jobs, sequences)
 
     def execution_state(self, now: float) -> ExecutionState:
-        """The state re-planning starts from (`fjsp_planner.core.replan`).
-
-        A robot may be reported starting its next job before the last OPERATION_DONE of the
-        job it left reaches the planner (they come from different robots): it leaves a job
-        only once the job is complete, so that job counts as done here.
-        """
+        """The state re-planning starts from (`fjsp_planner.core.replan`)."""
         now_f = Fraction(max(now, 0.0))
         ends = self.expected_ends(now)
         running = {}
@@ -425,11 +420,6 @@ class MissionTracker:
             planned = self.plan.jobs[name]
             running[name] = JobAssignment(name, planned.plan, Fraction(self.jobs[name].start),
                                           ends[name], dict(planned.robots))
-        left = set()
-        for robot in self.robots:
-            on = sorted((a.start, name) for name, a in running.items() if robot in a.robots)
-            left.update(name for _, name in on[:-1])
-        running = {name: a for name, a in running.items() if name not in left}
         robots = {}
         for name, r in self.robots.items():
             on = [j for j, a in running.items() if name in a.robots]
@@ -443,7 +433,7 @@ class MissionTracker:
             failed_at = None if r.last_failure_at is None else Fraction(r.last_failure_at)
             robots[name] = RobotState(name, r.healthy, location, free_at, failed_at)
         started = {name: Fraction(self.jobs[name].start) for name in self.done}
-        return ExecutionState(now_f, self.done | left, running, robots, started)
+        return ExecutionState(now_f, self.done, running, robots, started)
 
     def violations(self) -> list[str]:
         """Every way the executed timeline (the jobs done so far, as they ran) breaks the
