@@ -327,8 +327,9 @@ def write_report(config, exact, rl, optimum, optimum_schedule, subset, wall, qui
         'did worse; HiGHS branch and bound is serial); limits are in the tables. Times '
         "are wall-clock seconds on the solvers' own clocks, read from their logs (model "
         "building, well under a second, is not included). Makespans are in the paper's time "
-        'units; the instance is `config/scenarios/solar_panel.yaml` read as in SPEC §1.1, '
-        'panels shifted 60 apart (SPEC §1.2). Every schedule reported was checked by the '
+        'units; the instance is `config/scenarios/solar_panel.yaml` read as in '
+        '[model.md](model.md#the-papers-instance), panels shifted 60 apart '
+        '([model.md](model.md#several-panels)). Every schedule reported was checked by the '
         'independent validator in exact arithmetic (column "valid"). HiGHS through OR-Tools '
         "9.15's `pywraplp` loses its incumbent when it stops at a time limit (status code 99, "
         'google/or-tools#5016 and #5372): its first/best times come from its log, but it '

@@ -5,7 +5,7 @@ import math
 import pytest
 
 from fjsp_common.vocabulary import EventKind, RobotMode
-from robot_agents.execution import RobotExecution, Task
+from robot_agents.execution import RobotExecution, Task, later
 
 ARRIVED, STARTED, DONE, ABORTED = (EventKind.ARRIVED, EventKind.STARTED,
                                    EventKind.OPERATION_DONE, EventKind.ABORTED)
@@ -203,11 +203,17 @@ def test_delay_of_the_next_operation():
                                  (DONE, 'J2', 17)]   # only one operation slowed
 
 
+BOUNDS = 'a delay factor must be within [0.001, 1000]'
+
+
 @pytest.mark.parametrize(('factor', 'why'), [
-    (0.0, 'needs a finite factor > 0, got 0'),
-    (-2.0, 'needs a finite factor > 0, got -2'),
-    (math.nan, 'needs a finite factor > 0, got nan'),
-    (math.inf, 'needs a finite factor > 0, got inf'),
+    (0.0, f'{BOUNDS}, got 0'),
+    (-2.0, f'{BOUNDS}, got -2'),
+    (math.nan, f'{BOUNDS}, got nan'),
+    (math.inf, f'{BOUNDS}, got inf'),
+    (1e306, f'{BOUNDS}, got 1e+306'),          # killed the agent with an OverflowError
+    (1e-200, f'{BOUNDS}, got 1e-200'),
+    (1000.5, f'{BOUNDS}, got 1000.5'),
 ])
 def test_delay_refuses_bad_factors(factor, why):
     r = RobotExecution('A')
@@ -216,6 +222,47 @@ def test_delay_refuses_bad_factors(factor, why):
     result = r.delay(factor, 1)
     assert not result.accepted and result.message == f"delay refused: robot 'A' {why}"
     assert r.busy_until == pytest.approx(4)
+
+
+@pytest.mark.parametrize(('first', 'second', 'product'), [
+    (1e2, 1e2, '10000'), (0.02, 0.02, '0.0004'), (1e3, 1e3, '1e+06')])
+def test_compounded_delays_are_bounded_too(first, second, product):
+    """Two delays of 1e200 used to be accepted ("inf times its duration") and crash later;
+    two of 1e-200 compounded to 0: the product of the factors on one operation is bounded
+    like each factor."""
+    for now in (1, 0):       # while working on the operation, and before beginning it
+        r = RobotExecution('A')
+        plan(r, 1, [task('J1', 2, 4, leg=1), task('J2', 6, 4)])
+        r.step(now)
+        assert r.delay(first, now).accepted
+        ends = r.busy_until
+        result = r.delay(second, now)
+        assert not result.accepted
+        assert result.message == (f"delay refused: robot 'A' would make its operation take "
+                                  f'{product} times its duration; the factors on one '
+                                  'operation must multiply to within [0.001, 1000]')
+        assert r.busy_until == ends or (math.isnan(ends) and math.isnan(r.busy_until))
+
+
+def test_extreme_but_allowed_delays_run_to_the_end():
+    r = RobotExecution('A')
+    plan(r, 1, [task('J1', 0, 1e6)])
+    r.step(1)
+    assert r.delay(1000, 1).accepted
+    assert r.busy_until == pytest.approx(1e9)
+    assert kinds(r.step(2e9)) == [(DONE, 'J1', 1e9)]
+
+
+@pytest.mark.parametrize('t', [0.0, 1.5, 1e6, 1e9, 1e300, 1e306, math.inf, -math.inf,
+                               math.nan])
+def test_later_never_raises_nor_goes_back(t):
+    value = later(t)
+    if t <= 1e9:
+        assert t + 0.5e-6 <= value <= t + 1.6e-6     # half a grid step to one and a half
+    elif math.isfinite(t):
+        assert value >= t
+    else:
+        assert value == t or (math.isnan(value) and math.isnan(t))
 
 
 def test_delay_refused_when_nothing_is_left_to_do():

@@ -61,10 +61,20 @@ def test_tiny_files_solve_to_their_hand_checked_optimum(name, optimum):
     ('1 2\n2 1 1 4\n', 'operation 2: line ends early; it announces 2 operations'),
     ('1 2\n1 2 1 4 2\n', 'announces 2 machine/time pairs, line has only 3 numbers left'),
     ('1 2\n1 1 1 4 7\n', 'line 2 (job 1): 1 numbers left over after its 1 operations'),
-    ('1 2\n1 1 1 -4\n', 'time on machine 1 is negative'),
-    ('1 2\n1 1 1 four\n', "time on machine 1 must be a number, got 'four'"),
+    ('1 2\n1 1 1 -4\n', "time on machine 1: '-4' is outside [0, 1e+06]"),
+    ('1 2\n1 1 1 four\n', "time on machine 1: expected a finite number, got 'four'"),
+    ('1 2\n1 1 1 1e-999999999\n', 'time on machine 1: expected a finite number'),
     ('1 2\n1 2 1 4 1 5\n', 'machine 1 is listed twice'),
     ('1 2\n-1\n', 'number of operations must not be negative'),
+    # Beyond the limits of docs/scenario-format.md: CP-SAT overflowed on 1e23.
+    ('1 2\n1 1 1 1e23\n', "time on machine 1: '1e23' is outside [0, 1e+06]"),
+    ('1 2\n1 1 1 nan\n', "time on machine 1: expected a finite number, got 'nan'"),
+    ('1 2\n1 1 1 0.0000001\n', "time on machine 1: '0.0000001' is too precise"),
+    ('1 101\n1 1 1 3\n', 'number of machines: 101 is more than the limit of 100'),
+    ('1 1000000000\n1 1 1 3\n', 'number of machines: 1000000000 is more than the limit'),
+    ('1 1\n1001' + ' 1 1 1' * 1001 + '\n',
+     'operations (each one a job): 1001 is more than the limit'),
+    ('1 1\n' + '9' * 5000 + '\n', "number of operations must be an integer, got '999999"),
 ])
 def test_malformed_files_name_line_and_fault(text, message):
     with pytest.raises(ProblemError, match=re.escape(message)):
@@ -72,5 +82,20 @@ def test_malformed_files_name_line_and_fault(text, message):
 
 
 def test_missing_file_is_a_problem_error(tmp_path):
-    with pytest.raises(ProblemError, match='cannot read'):
+    with pytest.raises(ProblemError, match='absent.fjs: no such file'):
         load_fjs(tmp_path / 'absent.fjs')
+
+
+def test_bad_files_are_named(tmp_path):
+    with pytest.raises(ProblemError, match='is a directory, not a .fjs file'):
+        load_fjs(tmp_path)
+    latin = tmp_path / 'latin.fjs'
+    latin.write_bytes(b'1 1\n1 1 1 3 \xe9\n')
+    with pytest.raises(ProblemError, match=r'not UTF-8 text \(byte 0xe9 at offset 12\)'):
+        load_fjs(latin)
+
+
+def test_messages_stay_short():
+    with pytest.raises(ProblemError) as caught:
+        parse_fjs('1 1\n1 1 1 ' + 'x' * 10**6 + '\n')
+    assert len(str(caught.value)) < 300

@@ -1,4 +1,5 @@
-"""Re-planning after a failure (SPEC §2), on an instance small enough to re-plan on paper.
+"""Re-planning after a failure (docs/model.md, "Re-planning"), on an instance small enough
+to re-plan on paper.
 
     locations p, q at distance 4; type 2 is locomote; every robot is an Arm of speed 1
     (hold 2, weld 3, travel = distance) starting at p at time 0
@@ -118,6 +119,30 @@ def test_failure_while_holding_voids_the_jig_job(small):
     assert ('J', 'W', 0) in p.holding
 
 
+def test_holder_that_failed_and_came_back_voids_the_jig_job(small):
+    """A failed at 9/4 while holding and was back by 5/2: what it held was let go, so J is
+    redone as if A were still out, although A may redo it."""
+    state = at(small, Fraction(5, 2))
+    a = state.robots['A']
+    back = replace(state, robots={**state.robots, 'A': replace(a, last_failure=Fraction(9, 4))})
+    residual = residual_problem(small, back, PLAN)
+    assert residual.voided == ['J'] and residual.kept == [] and residual.failed == []
+    assert 'A' in {r.name for r in residual.problem.robots}
+
+
+@pytest.mark.parametrize(('failed_at', 'started', 'voided'), [
+    (Fraction(-1), {}, []),                      # before the planned start of J (0)
+    (Fraction(0), {}, ['J']),                    # as J began
+    (Fraction(1, 2), {}, ['J']),                 # after J's planned start...
+    (Fraction(1, 2), {'J': Fraction(1)}, []),    # ...but before it actually began
+])
+def test_only_a_failure_since_the_jig_job_began_voids_it(small, failed_at, started, voided):
+    state = at(small, Fraction(5, 2))
+    robots = {**state.robots, 'A': replace(state.robots['A'], last_failure=failed_at)}
+    residual = residual_problem(small, replace(state, robots=robots, started=started), PLAN)
+    assert residual.voided == voided
+
+
 def test_healthy_holder_keeps_holding(small):
     """C fails at 5/2 while A holds since J: J stays, fixed with its holder only, so that the
     holding arc still sends A directly to W."""
@@ -181,8 +206,8 @@ def test_two_failures_block_with_the_reason(small):
     assert residual.problem is None and not residual.complete
     assert residual.aborted == ['J', 'P']
     assert residual.blocked == [
-        "job 'W' cannot be staffed: plan 0 [0, 1] needs 2 distinct robots able to do "
-        '[0, 1]; 1 healthy can (failed: A, B)']
+        "job 'W' cannot be staffed: plan 0 ['hold' (0), 'weld' (1)] needs 2 distinct robots "
+        "able to do ['hold' (0), 'weld' (1)]; 1 healthy can (failed: A, B)"]
 
 
 def test_recovered_robot_unblocks(small):
@@ -334,9 +359,10 @@ def test_paper_two_failures_block_then_recovery_unblocks(paper):
     state = simulated_state(problem, plan, Fraction(1), {'MARC1', 'MARC2'})
     result = replan(problem, plan, state)
     assert result.result is None
+    needs = "['hold frame link' (0) x2, 'weld connection point' (2)]"
     assert result.residual.blocked == [
-        f"job '{job}' cannot be staffed: plan 0 [0, 0, 2] needs 3 distinct robots able to "
-        'do [0, 0, 2]; 2 healthy can (failed: MARC1, MARC2)' for job in ('Aa', 'Ab')]
+        f"job '{job}' cannot be staffed: plan 0 {needs} needs 3 distinct robots able to "
+        f'do {needs}; 2 healthy can (failed: MARC1, MARC2)' for job in ('Aa', 'Ab')]
     marc1 = state.robots['MARC1']
     back = replace(state, robots={**state.robots, 'MARC1': replace(marc1, healthy=True)})
     check_replan(problem, plan, back)

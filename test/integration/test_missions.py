@@ -82,7 +82,8 @@ def test_goal_during_a_mission_and_broken_goal_are_rejected(fleet, observer):
     with pytest.raises(MissionError) as bad:
         fleet.submit(scenario_yaml=yaml.safe_dump(broken))
     text = '\n'.join(bad.value.problems)
-    assert "'glue'" in text, text
+    assert "unknown robot type 'Welder'" in text and "'glue'" in text, text
+    assert 'precedence cycle' in text, text
     assert running.result(timeout=60).complete  # the running mission was untouched
 
 

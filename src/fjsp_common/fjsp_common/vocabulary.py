@@ -7,6 +7,13 @@ Each enum member has a message constant of the same name (`RobotState.MODE_<NAME
 
 from enum import StrEnum
 
+MIN_DELAY_FACTOR = 1e-3
+MAX_DELAY_FACTOR = 1e3
+"""Bounds of one delay fault's factor, and of the product of the factors applied to one
+operation: durations are at most 1e6 units (docs/scenario-format.md), so a delayed operation
+stays within 1e9, where floats still resolve the agents' 1e-6 time grid. Agents refuse beyond
+them; fault tools refuse before sending."""
+
 
 class RobotMode(StrEnum):
     IDLE = 'idle'

@@ -1,21 +1,40 @@
-"""fjsp-solve: plan a scenario from the command line."""
+"""fjsp-solve: plan a scenario from the command line.
+
+Ctrl-C (SIGINT) and SIGTERM stop it at once at any stage, with one line on stderr and exit
+code 128 + the signal number. The work runs on a worker thread while the main thread only
+waits: Python runs signal handlers on the main thread between bytecodes, and CP-SAT solves in
+C++ without returning to the interpreter (and is told not to catch SIGINT itself), so a
+handler on a main thread busy solving would wait for the whole time limit.
+"""
 
 import argparse
 import json
+import math
+import os
+import signal
 import sys
+import threading
 from fractions import Fraction
 from pathlib import Path
 
 from fjsp_planner.core.problem import ProblemError
 from fjsp_planner.core.schedule import Result
-from fjsp_planner.core.solve import SOLVERS, solve
 from fjsp_planner.core.validate import validate
 
 EXIT_BAD_INPUT = 2
 EXIT_INVALID_SCHEDULE = 3
+MAX_WORKERS = 64
+
+_stage = 'starting'
+"""What the worker is doing, for the message of an interruption."""
 
 
 def main(argv=None) -> int:
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(signum, _interrupted)
+    # Imported after the handlers are in place: loading OR-Tools takes a noticeable moment.
+    from fjsp_planner.core.solve import SOLVERS
+
     parser = argparse.ArgumentParser(
         prog='fjsp-solve', description='Plan which robot does what, when, for a scenario '
         '(YAML, see docs/scenario-format.md) or a standard .fjs instance.')
@@ -23,12 +42,48 @@ def main(argv=None) -> int:
     parser.add_argument('--panels', type=_positive_int, help='repeat the jobs N times')
     parser.add_argument('--shift', type=_non_negative, help='distance between panels')
     parser.add_argument('--time-limit', type=_positive, default=10.0, metavar='S')
-    parser.add_argument('--workers', type=_positive_int, default=2, metavar='K')
+    parser.add_argument('--workers', type=_workers, default=2, metavar='K',
+                        help=f'solver threads, 1 to {MAX_WORKERS}')
     parser.add_argument('--solver', choices=SOLVERS, default='cpsat')
     parser.add_argument('--mip-backend', choices=('SCIP', 'HIGHS'), default='SCIP')
     parser.add_argument('--json', type=Path, metavar='OUT', help='write the result as JSON')
     parser.add_argument('--gantt', type=Path, metavar='OUT.png', help='draw the schedule')
     args = parser.parse_args(argv)
+    return _in_worker(lambda: _plan(args))
+
+
+def _interrupted(signum, frame):
+    name = signal.Signals(signum).name
+    sys.stdout.flush()
+    sys.stderr.write(f'fjsp-solve: stopped by {name} while {_stage}\n')
+    sys.stderr.flush()
+    # Exit at once, whatever the worker thread (maybe inside CP-SAT) is doing.
+    os._exit(128 + signum)
+
+
+def _in_worker(work) -> int:
+    """`work()`'s exit code, computed on a worker thread while this one waits for it."""
+    outcome = {}
+
+    def run():
+        try:
+            outcome['code'] = work()
+        except BaseException as error:  # handed to the main thread, which raises it
+            outcome['error'] = error
+
+    worker = threading.Thread(target=run, name='fjsp-solve', daemon=True)
+    worker.start()
+    worker.join()
+    if 'error' in outcome:
+        raise outcome['error']
+    return outcome['code']
+
+
+def _plan(args) -> int:
+    global _stage
+    from fjsp_planner.core.solve import solve
+
+    _stage = 'loading the scenario'
     try:
         problem = _load(args)
     except ProblemError as error:
@@ -36,8 +91,10 @@ def main(argv=None) -> int:
         for problem_text in error.problems:
             print(f'  - {problem_text}', file=sys.stderr)
         return EXIT_BAD_INPUT
+    _stage = 'solving'
     result = solve(problem, solver=args.solver, time_limit=args.time_limit,
                    workers=args.workers, mip_backend=args.mip_backend)
+    _stage = 'writing the result'
     if result.schedule is not None:
         violations = validate(problem, result.schedule)
         if violations:
@@ -49,20 +106,22 @@ def main(argv=None) -> int:
     print(status_line(result))
     for note in result.notes:
         print(f'note: {note}')
-    if args.json:
-        args.json.write_text(json.dumps(result_json(problem, result), indent=2) + '\n')
-    if args.gantt and result.schedule is not None:
-        from fjsp_planner.core.gantt import draw_gantt
+    try:
+        if args.json:
+            args.json.write_text(json.dumps(result_json(problem, result), indent=2) + '\n')
+        if args.gantt and result.schedule is not None:
+            from fjsp_planner.core.gantt import draw_gantt
 
-        draw_gantt(problem, result.schedule, args.gantt,
-                   title=f'{problem.name}: makespan {_number(result.makespan):g}')
+            draw_gantt(problem, result.schedule, args.gantt,
+                       title=f'{problem.name}: makespan {_number(result.makespan):g}')
+    except OSError as error:
+        print(f'fjsp-solve: cannot write {error.filename}: {error.strerror}', file=sys.stderr)
+        return EXIT_BAD_INPUT
     return 0 if result.schedule is not None else 1
 
 
 def _load(args):
     path = Path(args.scenario)
-    if not path.is_file():
-        raise ProblemError([f'{path}: no such file'])
     if path.suffix == '.fjs':
         from fjsp_planner.core.fjs import load_fjs
         from fjsp_planner.core.scenario import repeat_panels
@@ -138,18 +197,27 @@ def _positive_int(text):
     return value
 
 
+def _workers(text):
+    value = _positive_int(text)
+    if value > MAX_WORKERS:
+        raise argparse.ArgumentTypeError(f'must be at most {MAX_WORKERS}, got {text!r}')
+    return value
+
+
 def _positive(text):
     value = _parse(text, float)
-    if not value > 0:
-        raise argparse.ArgumentTypeError(f'must be positive, got {text!r}')
+    if not (value > 0 and math.isfinite(value)):
+        raise argparse.ArgumentTypeError(f'must be a finite number > 0, got {text!r}')
     return value
 
 
 def _non_negative(text):
-    value = _parse(text, Fraction)
-    if not value >= 0:
-        raise argparse.ArgumentTypeError(f'must not be negative, got {text!r}')
-    return value
+    from fjsp_planner.core import limits
+
+    try:
+        return limits.number(text, 'shift', Fraction(0), limits.MAX_TIME)
+    except ProblemError as error:
+        raise argparse.ArgumentTypeError(error.problems[0]) from None
 
 
 def _parse(text, kind):

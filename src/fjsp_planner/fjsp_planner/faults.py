@@ -27,9 +27,14 @@ import time
 import uuid
 from contextlib import contextmanager
 
+from fjsp_common.vocabulary import MAX_DELAY_FACTOR, MIN_DELAY_FACTOR
+
 FAULTS = ('fail', 'recover', 'delay')
 RESEND = 1.0
 """Seconds without an answer after which a fault request is sent again."""
+# The agent refuses beyond these, also for the product of several delays on one operation:
+# refused here before anything is sent.
+BOUNDS = f'within [{MIN_DELAY_FACTOR:g}, {MAX_DELAY_FACTOR:g}]'
 
 
 class FaultError(ValueError):
@@ -46,13 +51,16 @@ def check_fault(fault: str, factor: float | None) -> float:
                              "'delay' does")
         return 0.0
     if factor is None:
-        raise FaultError("fault 'delay' needs a factor > 0 (e.g. 2 to double durations)")
+        raise FaultError(f"fault 'delay' needs a factor {BOUNDS} (e.g. 2 to double "
+                         'durations)')
     try:
         factor = float(factor)
     except (TypeError, ValueError):
         raise FaultError(f"fault 'delay': factor must be a number, got {factor!r}") from None
     if not (math.isfinite(factor) and factor > 0):
         raise FaultError(f"fault 'delay': factor must be a finite number > 0, got {factor:g}")
+    if not MIN_DELAY_FACTOR <= factor <= MAX_DELAY_FACTOR:
+        raise FaultError(f"fault 'delay': factor must be {BOUNDS}, got {factor:g}")
     return factor
 
 
@@ -187,7 +195,7 @@ def main(argv=None) -> int:
     parser.add_argument('fault', choices=FAULTS)
     parser.add_argument('--factor', type=float,
                         help="delay only: multiply the current (or next) operation's "
-                             'duration by F (> 0)')
+                             f'duration by F ({BOUNDS})')
     parser.add_argument('--key-file', metavar='FILE',
                         help='fleet key to sign the request with (default: '
                              '$FJSP_FLEET_KEY_FILE; none: unsigned)')

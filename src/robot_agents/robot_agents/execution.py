@@ -17,7 +17,7 @@ import math
 from dataclasses import dataclass, field
 from enum import StrEnum
 
-from fjsp_common.vocabulary import EventKind, RobotMode
+from fjsp_common.vocabulary import MAX_DELAY_FACTOR, MIN_DELAY_FACTOR, EventKind, RobotMode
 
 # Reported ends are rounded up onto this grid (schedule units) so that float rounding never
 # makes an operation or a leg look shorter than it is when checked in exact arithmetic.
@@ -25,8 +25,16 @@ GRID = 1e-6
 
 
 def later(t: float) -> float:
-    """The first grid point at least half a grid step after t."""
-    return math.ceil(t / GRID + 0.5) * GRID
+    """The first grid point at least half a grid step after t; t itself where t is not finite
+    or too large for the grid to mean anything. Never raises."""
+    scaled = t / GRID + 0.5
+    if not math.isfinite(scaled):
+        return t
+    return max(t, math.ceil(scaled) * GRID)
+
+
+def _within_delay_bounds(factor: float) -> bool:
+    return MIN_DELAY_FACTOR <= factor <= MAX_DELAY_FACTOR
 
 
 @dataclass(frozen=True)
@@ -325,23 +333,36 @@ class RobotExecution:
         return FaultResult(True, message)
 
     def delay(self, factor: float, now: float) -> FaultResult:
-        """Multiply the duration of the operation under way, or else of the next one."""
-        if not (math.isfinite(factor) and factor > 0):
-            return self._refuse('delay', f'needs a finite factor > 0, got {factor:g}')
+        """Multiply the duration of the operation under way, or else of the next one.
+
+        The factor, and the product of the factors on one operation, must lie within
+        [MIN_DELAY_FACTOR, MAX_DELAY_FACTOR]; beyond, the delay is refused.
+        """
+        if not _within_delay_bounds(factor):       # NaN fails every comparison
+            return self._refuse('delay', f'a delay factor must be within '
+                                         f'[{MIN_DELAY_FACTOR:g}, {MAX_DELAY_FACTOR:g}], '
+                                         f'got {factor:g}')
         if self._phase == _Phase.FAILED:
             return self._refuse('delay', 'has failed')
         events = self.step(now)
-        if self._phase == _Phase.WORK:
-            self._work_factor *= factor
+        working = self._phase == _Phase.WORK
+        if not working and not self._work_left():
+            return self._refuse('delay', 'has no operation left to do', events)
+        product = (self._work_factor if working else self._factor) * factor
+        if not _within_delay_bounds(product):
+            return self._refuse('delay', f'would make its operation take {product:g} times '
+                                         'its duration; the factors on one operation must '
+                                         f'multiply to within [{MIN_DELAY_FACTOR:g}, '
+                                         f'{MAX_DELAY_FACTOR:g}]', events)
+        if working:
+            self._work_factor = product
             end = self._phase_start + self.task.duration * self._work_factor
             # A speed-up cannot end the operation before it was ordered.
             self._phase_end = later(max(end, now))
             return FaultResult(True, f"robot '{self.robot}': operation of job "
                                      f"'{self.task.job}' now ends at t={self._phase_end:.2f}",
                                events)
-        if not self._work_left():
-            return self._refuse('delay', 'has no operation left to do', events)
-        self._factor *= factor
+        self._factor = product
         return FaultResult(True, f"robot '{self.robot}': the next operation it begins takes "
                                  f'{self._factor:g} times its duration', events)
 

@@ -4,18 +4,20 @@ Format: the first line is `n m [average machines per operation]`; then one line 
 the number of operations, then for each operation `k` followed by `k` pairs
 `machine time` (machines numbered from 1).
 
-The classic FJSP is the special case of SPEC §1 where every job of the benchmark is a chain
-of single-robot operations. Each benchmark operation therefore becomes one job of ours
-(`J2.O3` is operation 3 of job 2, both 1-indexed) with a single one-operation plan whose
-operation type belongs to that operation alone; each machine becomes a robot `M<i>` of its
-own robot type, whose efficiency for an operation type is the machine's processing time.
-The operations of a benchmark job are chained by precedence arcs. Everything happens at one
-location and travel is free (`locomote=None`).
+The classic FJSP is the special case of our model (docs/model.md) where every job of the
+benchmark is a chain of single-robot operations. Each benchmark operation therefore becomes
+one job of ours (`J2.O3` is operation 3 of job 2, both 1-indexed) with a single
+one-operation plan whose operation type belongs to that operation alone; each machine
+becomes a robot `M<i>` of its own robot type, whose efficiency for an operation type is the
+machine's processing time. The operations of a benchmark job are chained by precedence
+arcs. Everything happens at one location and travel is free (`locomote=None`).
 """
 
 from fractions import Fraction
 from pathlib import Path
 
+from fjsp_planner.core import limits
+from fjsp_planner.core.limits import shown
 from fjsp_planner.core.problem import Job, Problem, ProblemError, Robot
 
 LOCATION = 'shop'
@@ -24,10 +26,7 @@ LOCATION = 'shop'
 def load_fjs(path) -> Problem:
     """Parse an `.fjs` file; a malformed file raises `ProblemError` naming the line."""
     path = Path(path)
-    try:
-        text = path.read_text()
-    except (OSError, UnicodeDecodeError) as error:
-        raise ProblemError([f'{path}: cannot read: {error}']) from error
+    text = limits.read_input_file(path, '.fjs')
     return parse_fjs(text, name=path.stem, source=str(path))
 
 
@@ -42,6 +41,11 @@ def parse_fjs(text: str, name: str = 'fjs', source: str = '<text>') -> Problem:
                             f'[average]", got {len(header)} fields'])
     n_jobs = _count(header[0], 'number of jobs', source, header_line)
     n_machines = _count(header[1], 'number of machines', source, header_line)
+    # Each machine is a robot, and each operation a job: bounded before anything is built.
+    too_many = limits.count_problem(f'{source} line {header_line}: number of machines',
+                                    n_machines, limits.MAX_ROBOTS)
+    if too_many:
+        raise ProblemError(too_many)
     job_lines = lines[1:]
     if len(job_lines) != n_jobs:
         raise ProblemError([f'{source}: header (line {header_line}) announces {n_jobs} jobs '
@@ -61,12 +65,19 @@ def parse_fjs(text: str, name: str = 'fjs', source: str = '<text>') -> Problem:
                 efficiency[machines[machine - 1]][q] = time
             jobs.append(Job(op_name, LOCATION, ((q,),)))
             names.append(op_name)
+            if len(jobs) > limits.MAX_JOBS:
+                raise ProblemError(limits.count_problem(
+                    f'{where}: operations (each one a job)', len(jobs), limits.MAX_JOBS))
         precedence.extend(zip(names, names[1:], strict=False))
 
+    robots = tuple(Robot(machine, machine) for machine in machines)
+    too_large = limits.scale_problems(robots, efficiency, jobs, {}, None, {})
+    if too_large:
+        raise ProblemError([f'{source}: {p}' for p in too_large])
     return Problem(
         operation_types=operation_types,
         robot_types=efficiency,
-        robots=tuple(Robot(machine, machine) for machine in machines),
+        robots=robots,
         jobs=tuple(jobs),
         precedence=tuple(precedence),
         name=name,
@@ -108,18 +119,12 @@ def _count(token, what, where, line=None):
     try:
         value = int(token)
     except ValueError:
-        raise ProblemError([f'{at}: {what} must be an integer, got {token!r}']) from None
+        raise ProblemError([f'{at}: {what} must be an integer, got {shown(token)}']) from None
     if value < 0:
         raise ProblemError([f'{at}: {what} must not be negative, got {value}'])
     return value
 
 
 def _time(token, where, machine):
-    try:
-        value = Fraction(token)
-    except (ValueError, ZeroDivisionError):
-        raise ProblemError([f'{where}: time on machine {machine} must be a number, '
-                            f'got {token!r}']) from None
-    if value < 0:
-        raise ProblemError([f'{where}: time on machine {machine} is negative ({token})'])
-    return value
+    return limits.number(token, f'{where}: time on machine {machine}', Fraction(0),
+                         limits.MAX_TIME)

@@ -9,12 +9,12 @@ Where the printed model slips, this module implements the evident intent:
 
 1. Travel (printed `s_j >= c_j' + (S_jj'm + L) x_jj'm - L`, with x_jj'm = "m moves from j to
    j'"): the arc must be the one *into* j, so we write
-   `s_j >= c_j' + (S_j'jm + L) x_j'jm - L`. Under SPEC §1 every robot of j' is busy until
-   c_j', so c_j' (not the robot's own operation end) is right.
+   `s_j >= c_j' + (S_j'jm + L) x_j'jm - L`. In our model (docs/model.md) every robot of j'
+   is busy until c_j', so c_j' (not the robot's own operation end) is right.
 2. Per-operation assignment (printed `x_jp = Σ_m Σ_o x_jpom  ∀ j,p`, which would staff only one
    operation of a plan): `Σ_m x_jpom = x_jp  ∀ j,p,o`.
 3. Robot on job (printed `Σ_p Σ_o x_jpom <= x_jm  ∀ j,p,m`): `=` and `∀ j,m`, so x_jm is 1
-   exactly when m does an operation of j; with x_jm binary this is also SPEC's "a robot does
+   exactly when m does an operation of j; with x_jm binary this is also the model's "a robot does
    at most one operation of a job".
 4. Path ends (printed `Σ_j x^start_jm = Σ_j x^end_jm = 1`): `<= 1`, so a robot may stay idle
    (an FJSP machine nobody needs, a spare robot).
@@ -23,7 +23,7 @@ Where the printed model slips, this module implements the evident intent:
    plans are multisets: `Σ_p Σ_{o: type q} x_jpom = Σ_p' Σ_{o: type q} x_j'p'om` and
    `x_jj'm >= Σ_p Σ_{o: type q} x_jpom  ∀ m, (j, j', q) ∈ H` (no arc variable: no holder m).
 
-Extensions of SPEC §1 the paper does not print: a robot with a start location travels from it
+Extensions (docs/model.md) the paper does not print: a robot with a start location travels from it
 to its first job, and no robot starts a new job before its release time (a robot released
 after the running job it is on ends cannot start its next job before then); a fixed (already
 running) job keeps its plan, robots and times and is the first job of its robots. Arcs

@@ -84,16 +84,6 @@ class EventReport:
     time: float
 
 
-def executed_violations(tracker: MissionTracker) -> list[str]:
-    """What the executed timeline breaks (precedence, holding, staffing, travel). Robots
-    count as starting wherever their first job was, at any time: across re-plans and
-    successive missions, that is where they were."""
-    free = replace(tracker.problem, robots=tuple(
-        replace(r, start_location=None, release_time=Fraction(0))
-        for r in tracker.problem.robots))
-    return validate(free, tracker.executed_schedule())
-
-
 # --- effects: what the node must do ----------------------------------------------------
 
 @dataclass(frozen=True)
@@ -334,27 +324,33 @@ class MissionController:
 
     def robot_state(self, report: RobotReport, wall: float) -> list[Effect]:
         agent = self.agents.get(report.robot)
-        effects: list[Effect] = []
         if agent is None:
-            self.agents[report.robot] = _Agent(report, wall)
+            agent = self.agents[report.robot] = _Agent(report, wall)
         else:
             if agent.offline_since is not None and agent.back_since is None:
                 agent.back_since = wall
             agent.report, agent.heard = report, wall
         mission = self.mission
         if mission is None:
-            return effects
+            return []
         if report.robot not in mission.tracker.robots:
             outcome = mission.tracker.record_robot_state(report.robot, report.mode, '', '',
                                                          math.nan)
-            if not outcome.repeated:
-                effects.append(Note(MissionEventKind.WARNING, (self._unknown(report.robot),),
-                                    robot=report.robot))
-            return effects
+            if outcome.repeated:
+                return []
+            return [Note(MissionEventKind.WARNING, (self._unknown(report.robot),),
+                         robot=report.robot)]
+        if agent.offline_since is not None:
+            return []  # the tracker hears it again once it counts again
+        return self._record(mission, report, wall)
+
+    def _record(self, mission: _Mission, report: RobotReport, wall: float) -> list[Effect]:
+        """Give the tracker a robot's report; the story of what changed."""
+        effects: list[Effect] = []
         before = mission.tracker.robots[report.robot].mode
         mission.tracker.record_robot_state(report.robot, report.mode, report.location,
                                            report.destination, report.busy_until,
-                                           report.current_job)
+                                           report.current_job, at=self._now(mission, wall))
         if report.mode == RobotMode.FAILED and before != RobotMode.FAILED:
             effects.append(Note(MissionEventKind.ROBOT_FAILED, robot=report.robot))
         if report.refusal and report.refusal not in mission.warned:
@@ -362,7 +358,6 @@ class MissionController:
             effects.append(Note(MissionEventKind.WARNING,
                                 (f"robot '{report.robot}' refuses its plan: {report.refusal}",),
                                 robot=report.robot))
-        self._mark_offline_as_heard(report.robot)
         return effects
 
     def task_event(self, event: EventReport, wall: float) -> tuple[list[Effect], str]:
@@ -449,31 +444,22 @@ class MissionController:
             if agent.offline_since is None and silent > timeout:
                 agent.offline_since, agent.back_since = wall, None
                 if self.mission is not None and name in self.mission.tracker.robots:
-                    self.mission.tracker.mark_offline(name)
+                    self.mission.tracker.mark_offline(name, at=self._now(self.mission, wall))
                     effects.append(Note(MissionEventKind.ROBOT_OFFLINE,
                                         (f'no state for {silent:.1f} s',), robot=name))
             elif agent.back_since is not None and silent <= timeout \
                     and wall - agent.back_since >= timeout:
                 agent.offline_since = agent.back_since = None
-                self._mark_offline_as_heard(name)
                 if self.mission is not None and name in self.mission.tracker.robots:
                     effects.append(Note(MissionEventKind.ROBOT_BACK,
                                         (f'reporting again ({agent.report.mode})',),
                                         robot=name))
+                    effects += self._record(self.mission, agent.report, wall)
         return effects
 
     def _heard(self, robot: str) -> bool:
         agent = self.agents.get(robot)
         return agent is not None and agent.offline_since is None
-
-    def _mark_offline_as_heard(self, robot: str) -> None:
-        """The tracker shows a robot offline for as long as its agent is judged offline,
-        whatever its latest report says."""
-        agent = self.agents.get(robot)
-        mission = self.mission
-        if mission is not None and agent is not None and agent.offline_since is not None \
-                and robot in mission.tracker.robots:
-            mission.tracker.mark_offline(robot)
 
     # --- solving ---------------------------------------------------------------------------
 
@@ -587,6 +573,14 @@ class MissionController:
                                              for p in problems))
         mission.planned = solving.fleet
         mission.start = wall + mission.settings.start_delay
+        if posed is not mission.problem:
+            # The mission starts where the robots are: its executed timeline is judged so.
+            starts = {r.name: r.start_location for r in posed.robots}
+            problem = replace(mission.problem, robots=tuple(
+                replace(r, start_location=starts.get(r.name, r.start_location))
+                for r in mission.problem.robots))
+            mission.problem = problem
+            mission.tracker.extend(problem)
         return self._publish(mission, posed, result, frozenset(), ())
 
     def _new_revision(self, mission, solving, outcome, wall, fleet_now) -> list[Effect]:
@@ -709,7 +703,7 @@ class MissionController:
     def _complete(self, mission) -> list[Effect]:
         """Every job reported done: the mission is complete if what was executed is a valid
         schedule, and failed otherwise."""
-        violations = executed_violations(mission.tracker)
+        violations = mission.tracker.violations()
         if violations:
             return self._fail(mission, tuple(f'executed timeline: {v}' for v in violations))
         mission.state = MissionState.COMPLETE

@@ -1,4 +1,4 @@
-"""The scheduling problem of SPEC §1: plain, immutable data checked at construction.
+"""The scheduling problem of docs/model.md: plain, immutable data checked at construction.
 
 Times are exact `Fraction`s: travel times such as distance * 10/3 must not be rounded
 before a solver decides how to put them on its own grid.
@@ -65,18 +65,19 @@ class Problem:
     """(robot, operation type) -> time, replacing the robot type's efficiency."""
     fixed: Mapping[str, FixedJob] = field(default_factory=dict)
     panels: tuple[tuple[str, ...], ...] = ()
-    """Identical copies of one job set (SPEC §1.2), job k of each copy matching; solvers
-    may use this to break the symmetry between copies and to bound moves between them."""
+    """Identical copies of one job set (docs/model.md, "Several panels"), job k of each
+    copy matching; solvers may use this to break the symmetry between copies and to bound
+    moves between them."""
     name: str = 'problem'
 
     def __post_init__(self):
-        problems = _structural_problems(self)
-        if problems:
-            raise ProblemError(problems)
         object.__setattr__(self, '_robot_by_name', {r.name: r for r in self.robots})
         object.__setattr__(self, '_job_by_name', {j.name: j for j in self.jobs})
         object.__setattr__(self, '_travel_cache', {})
-        problems = _cycle_problems(self) + _holding_problems(self) + _staffing_problems(self)
+        # Every check skips what an earlier one already reported (an unknown job in an arc,
+        # a robot of an unknown type), so one pass names every problem, each once.
+        problems = (_structural_problems(self) + _cycle_problems(self)
+                    + _holding_problems(self) + _staffing_problems(self))
         if problems:
             raise ProblemError(problems)
 
@@ -108,6 +109,17 @@ class Problem:
             self._travel_cache[key] = (self.distance(a, b)
                                        * self.robot_types[r.type][self.locomote] / r.speed)
         return self._travel_cache[key]
+
+    def operation_label(self, q: int) -> str:
+        """An operation type as the user wrote it, with its id: `'weld' (2)`."""
+        name = self.operation_types.get(q)
+        return f"'{name}' ({q})" if name is not None else str(q)
+
+    def plan_label(self, plan) -> str:
+        """A plan (a multiset of operation types) by name: `['hold' (0) x2, 'weld' (2)]`."""
+        counts = Counter(plan)
+        return '[' + ', '.join(self.operation_label(q) + (f' x{n}' if n > 1 else '')
+                               for q, n in sorted(counts.items())) + ']'
 
     def locations(self) -> list[str]:
         names = {j.location for j in self.jobs}
@@ -149,10 +161,12 @@ def _structural_problems(p: Problem) -> list[str]:
             if q not in p.operation_types:
                 problems.append(f"robot type '{type_name}': unknown operation type {q}")
             elif time < 0:
-                problems.append(f"robot type '{type_name}': negative time {time} for type {q}")
-        if p.locomote is not None and p.locomote not in efficiency:
+                problems.append(f"robot type '{type_name}': negative time {time} for "
+                                f'operation type {p.operation_label(q)}')
+        if p.locomote in p.operation_types and p.locomote not in efficiency:
             problems.append(f"robot type '{type_name}' has no efficiency for the locomote "
-                            f'operation type {p.locomote}, so it cannot travel')
+                            f'operation type {p.operation_label(p.locomote)}, so it cannot '
+                            'travel')
     for r in p.robots:
         if r.type not in p.robot_types:
             problems.append(f"robot '{r.name}': unknown robot type '{r.type}'")
@@ -166,7 +180,8 @@ def _structural_problems(p: Problem) -> list[str]:
         if q not in p.operation_types:
             problems.append(f"time override for '{robot}' names unknown operation type {q}")
         if time < 0:
-            problems.append(f"time override for '{robot}', type {q}: negative time {time}")
+            problems.append(f"time override for '{robot}', operation type "
+                            f'{p.operation_label(q)}: negative time {time}')
     for j in p.jobs:
         if not j.plans:
             problems.append(f"job '{j.name}' has no process plan")
@@ -180,18 +195,19 @@ def _structural_problems(p: Problem) -> list[str]:
     for (a, b), d in p.distances.items():
         if d < 0:
             problems.append(f"distance '{a}'-'{b}' is negative ({d})")
-    if p.locomote is not None:
+    if p.locomote in p.operation_types:
         problems.extend(_missing_distances(p))
     for a, b in p.precedence:
         for name in (a, b):
             if name not in jobs:
                 problems.append(f"precedence arc ('{a}', '{b}') names unknown job '{name}'")
     for a, b, q in p.holding:
+        arc = _holding_label(p, a, b, q)
         for name in (a, b):
             if name not in jobs:
-                problems.append(f"holding arc ('{a}', '{b}', {q}) names unknown job '{name}'")
+                problems.append(f"{arc} names unknown job '{name}'")
         if q not in p.operation_types:
-            problems.append(f"holding arc ('{a}', '{b}', {q}): unknown operation type {q}")
+            problems.append(f'{arc}: unknown operation type {q}')
     sizes = {len(panel) for panel in p.panels}
     if len(sizes) > 1:
         problems.append(f'panels must be copies of one job set; their sizes differ: {sizes}')
@@ -229,7 +245,8 @@ def _cycle_problems(p: Problem) -> list[str]:
     """Name one cycle of the precedence graph (holding arcs order jobs too), if any."""
     successors = {j.name: [] for j in p.jobs}
     for a, b in list(p.precedence) + [(a, b) for a, b, _ in p.holding]:
-        successors[a].append(b)
+        if a in successors and b in successors:
+            successors[a].append(b)
     state = {}
     for root in successors:
         if root in state:
@@ -252,24 +269,32 @@ def _cycle_problems(p: Problem) -> list[str]:
     return []
 
 
+def _holding_label(p: Problem, a: str, b: str, q: int) -> str:
+    return f"holding arc ('{a}', '{b}', {p.operation_label(q)})"
+
+
 def _holding_problems(p: Problem) -> list[str]:
     problems = []
     seen_from, seen_to = {}, {}
     for a, b, q in p.holding:
-        arc = f"holding arc ('{a}', '{b}', {q})"
+        if a not in p._job_by_name or b not in p._job_by_name or q not in p.operation_types:
+            continue
+        arc = _holding_label(p, a, b, q)
         if a == b:
             problems.append(f'{arc} joins a job to itself')
             continue
         for name in (a, b):
             if not any(q in plan for plan in p.job(name).plans):
-                problems.append(f"{arc} needs operation type {q} but job '{name}' "
-                                'has no such operation')
+                problems.append(f'{arc} needs operation type {p.operation_label(q)} but job '
+                                f"'{name}' has no such operation")
         if (a, q) in seen_from:
-            problems.append(f"{arc}: job '{a}' already holds type {q} into "
-                            f"'{seen_from[a, q]}'; a robot cannot go directly to both")
+            problems.append(f"{arc}: job '{a}' already holds operation type "
+                            f"{p.operation_label(q)} into '{seen_from[a, q]}'; a robot cannot "
+                            'go directly to both')
         if (b, q) in seen_to:
-            problems.append(f"{arc}: job '{b}' is already held with type {q} from "
-                            f"'{seen_to[b, q]}'; a robot cannot come directly from both")
+            problems.append(f"{arc}: job '{b}' is already held with operation type "
+                            f"{p.operation_label(q)} from '{seen_to[b, q]}'; a robot cannot "
+                            'come directly from both')
         seen_from[a, q] = b
         seen_to[b, q] = a
     return problems
@@ -277,18 +302,25 @@ def _holding_problems(p: Problem) -> list[str]:
 
 def _staffing_problems(p: Problem) -> list[str]:
     """A job none of whose plans can be given distinct, able robots."""
+    robots = [r.name for r in p.robots if r.type in p.robot_types]
+    untyped = sorted({r.name for r in p.robots} - set(robots))
+    # A robot of an unknown type (reported already) may be the one meant to do the job.
+    besides = (' (not counting ' + ', '.join(f"'{r}'" for r in untyped)
+               + ', of unknown type)') if untyped else ''
     problems = []
     for job in p.jobs:
-        if job.name in p.fixed:
+        if job.name in p.fixed or not job.plans:
             continue
         shortfalls = []
         for index, plan in enumerate(job.plans):
-            staffed = max_staffed(p, plan, [r.name for r in p.robots])
+            staffed = max_staffed(p, plan, robots)
             if staffed < len(plan):
-                shortfalls.append(f'plan {index} {sorted(plan)} needs {len(plan)} distinct '
-                                  f'robots able to do its operations; {staffed} can')
+                shortfalls.append(f'plan {index} {p.plan_label(plan)} needs {len(plan)} '
+                                  f'distinct robots able to do its operations; {staffed} '
+                                  'can')
         if len(shortfalls) == len(job.plans):
-            problems.append(f"job '{job.name}' cannot be staffed: " + '; '.join(shortfalls))
+            problems.append(f"job '{job.name}' cannot be staffed: " + '; '.join(shortfalls)
+                            + besides)
     return problems
 
 

@@ -1,4 +1,4 @@
-"""Re-planning after off-nominal events (SPEC §2): the problem that remains, and its solution.
+"""Re-planning after off-nominal events (docs/model.md, "Re-planning"): what remains, solved.
 
 A failure turns the executing mission into a smaller problem posed at `now`:
 
@@ -8,11 +8,12 @@ A failure turns the executing mission into a smaller problem posed at `now`:
   plan and robots and its expected end;
 - a running job with a failed robot is aborted: it is redone from scratch, and its healthy
   robots are free at `now`, at the job's location;
-- a completed jig job whose holder failed before the held job finished is voided (the hold
-  it set up is lost) and redone, and the held job, if running, is aborted;
+- a completed jig job whose holder failed (or went offline) after it began and before the
+  held job finished is voided (the hold it set up is lost, even if the holder is back) and
+  redone, and the held job, if running, is aborted;
 - a completed jig job whose held job has not finished (not started, or aborted) and whose
-  holders are healthy stays as a `FixedJob` of just its holders: the holders are still
-  holding, and only its holding arc forces them to go directly to the held job;
+  holders never failed since it began stays as a `FixedJob` of just its holders: the holders
+  are still holding, and only its holding arc forces them to go directly to the held job;
 - every healthy robot starts where it is, or where it is travelling to, released at
   max(now, free_at); a failed robot is left out, so it gets nothing.
 
@@ -48,6 +49,8 @@ class RobotState:
     """Where it is, or where it is travelling to; None: never placed (may start anywhere)."""
     free_at: Fraction
     """When it can start something new: the end of its running job, or its arrival."""
+    last_failure: Fraction | None = None
+    """When it last became failed or offline, even if it is healthy again; None: never."""
 
 
 @dataclass(frozen=True)
@@ -59,6 +62,9 @@ class ExecutionState:
     """Jobs in progress: actual start, plan and robots; `end` is the expected end."""
     robots: Mapping[str, RobotState]
     """Every robot of the problem, by name."""
+    started: Mapping[str, Fraction] = field(default_factory=dict)
+    """Actual starts of completed jobs, where known: a hold is lost if a holder failed after
+    its jig job began (the planned start counts where the actual one is not given)."""
 
 
 @dataclass(frozen=True)
@@ -68,7 +74,8 @@ class Residual:
     blocked: list[str]
     """Why what remains cannot be done by the healthy robots, one reason per job."""
     voided: list[str]
-    """Completed jig jobs to redo because a holder failed before the held job finished."""
+    """Completed jig jobs to redo because a holder failed (even if it is back now) after the
+    jig job began and before the held job finished."""
     aborted: list[str]
     """Running jobs to redo from scratch: a robot on them failed, or their hold was lost."""
     kept: list[str] = field(default_factory=list)
@@ -170,7 +177,8 @@ def residual_problem(problem: Problem, state: ExecutionState,
     aborted = {name for name, a in state.running.items()
                if not set(a.robots) <= healthy or name in release}
     holds = _open_holds(problem, state, previous)
-    voided = {h.source for h in holds if not set(h.holders) <= healthy or h.source in release}
+    voided = {h.source for h in holds
+              if not set(h.holders) <= healthy or h.source in release or _lost(h, state)}
     aborted.update(h.target for h in holds if h.source in voided and h.target in state.running)
     fixed = {name: a for name, a in state.running.items() if name not in aborted}
     kept, began = {}, {}
@@ -237,6 +245,16 @@ def _open_holds(problem, state, previous) -> list[_Hold]:
     return holds
 
 
+def _lost(hold: _Hold, state: ExecutionState) -> bool:
+    """A holder failed, however briefly, after the jig job began: what it held was let go."""
+    began = state.started.get(hold.source, hold.began)
+    for robot in hold.holders:
+        failed = state.robots[robot].last_failure
+        if failed is not None and failed >= began:
+            return True
+    return False
+
+
 def _longest(problem, robots: Mapping[str, int]) -> Fraction:
     return max(problem.duration(r, q) for r, q in robots.items())
 
@@ -283,16 +301,17 @@ def _staffing_problems(problem, todo, healthy, kept, failed) -> list[str]:
             rest = Counter(plan)
             rest.subtract(holders.values())
             if min(rest.values(), default=0) < 0:
-                shortfalls.append(f'plan {index} {sorted(plan)} has no place for the '
-                                  f'holders {_named(holders)}')
+                shortfalls.append(f'plan {index} {problem.plan_label(plan)} has no place for '
+                                  f'the holders {_named(holders)}')
                 continue
             rest_plan = list(rest.elements())
             staffed = max_staffed(problem, rest_plan, others)
             if staffed < len(rest_plan):
                 held = f' besides the holders {_named(holders)}' if holders else ''
-                shortfalls.append(f'plan {index} {sorted(plan)} needs {len(rest_plan)} '
-                                  f'distinct robots able to do {sorted(rest_plan)}{held}; '
-                                  f'{staffed} healthy can')
+                shortfalls.append(f'plan {index} {problem.plan_label(plan)} needs '
+                                  f'{len(rest_plan)} distinct robots able to do '
+                                  f'{problem.plan_label(rest_plan)}{held}; {staffed} healthy '
+                                  'can')
         if len(shortfalls) == len(job.plans):
             problems.append(f"job '{job.name}' cannot be staffed: " + '; '.join(shortfalls)
                             + why_short)
@@ -433,5 +452,7 @@ def simulated_state(problem: Problem, schedule: Schedule, now: Fraction,
                 location, free_at = here, visit.arrival
             break
         robots[robot.name] = RobotState(robot.name, robot.name not in failed, location,
-                                        max(now, free_at))
-    return ExecutionState(now, frozenset(finished), running, robots)
+                                        max(now, free_at),
+                                        now if robot.name in failed else None)
+    started = {name: a.start for name, a in schedule.jobs.items() if name in finished}
+    return ExecutionState(now, frozenset(finished), running, robots, started)

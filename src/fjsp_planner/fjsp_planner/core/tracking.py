@@ -2,24 +2,30 @@
 
 Times are schedule units since the mission start. The tracker turns task events into the
 facts re-planning needs (`execution_state`: done and running jobs, where each robot is and
-when it is free), the executed timeline (`executed_schedule`, checkable by `validate`), a
-projected makespan and the operations running late (`overruns`). Every report it cannot use
-is classified and counted, never raised.
+when it is free, when it last failed), the executed timeline (`executed_schedule`, and what
+it breaks: `violations`), a projected makespan and the operations running late (`overruns`),
+and which robots failed, even briefly, since a plan revision (`failed_since`). Every report it
+cannot use (malformed, out of order, naming what does not exist) is classified and counted,
+never raised: a message must not crash the planner.
 
 A plan revision either continues a job (it was under way) or starts it afresh: reports about
 a job made under a revision older than the one that last started it no longer count.
 """
 
+import dataclasses
 import math
+import numbers
 from collections import Counter
 from dataclasses import dataclass, field
 from enum import StrEnum
 from fractions import Fraction
 
 from fjsp_common.vocabulary import EventKind, RobotMode
+from fjsp_planner.core.limits import shown
 from fjsp_planner.core.problem import Problem
 from fjsp_planner.core.replan import ExecutionState, RobotState
 from fjsp_planner.core.schedule import JobAssignment, Schedule
+from fjsp_planner.core.validate import validate
 
 
 class Ignored(StrEnum):
@@ -28,6 +34,16 @@ class Ignored(StrEnum):
     STALE = 'stale'
     DUPLICATE = 'duplicate'
     UNKNOWN = 'unknown'
+
+
+UNHEALTHY_MODES = frozenset({RobotMode.FAILED, RobotMode.OFFLINE})
+ROBOT_EVENTS = frozenset(EventKind) - {EventKind.JOB_DONE}
+"""What robots report; only the planner declares a job done."""
+
+MAX_REPORTED_TIME = 1e12
+"""No mission within docs/scenario-format.md's limits lasts longer (1000 jobs, each at most
+1e6 units of work and 1e6 of travel, delayed up to 1000 times): a later time is a bad report,
+and would overflow the solvers when re-planning from it."""
 
 
 @dataclass
@@ -53,19 +69,22 @@ class JobRecord:
 @dataclass
 class RobotRecord:
     name: str
-    mode: RobotMode | None = None
-    """None until it reports."""
+    mode: str = ''
     location: str = ''
     destination: str = ''
     busy_until: float = math.nan
     current_job: str = ''
     reported: bool = False
+    failures: int = 0
+    """Transitions from healthy to failed or offline, however brief."""
+    last_failure_at: float | None = None
+    """When it last became failed or offline (schedule units); None if it never did."""
 
     @property
     def healthy(self) -> bool:
         """Failed or offline robots are not; one that has not reported yet is taken to be
         (it gets its tasks when it joins)."""
-        return self.mode is None or self.mode.healthy
+        return self.mode not in UNHEALTHY_MODES
 
 
 @dataclass(frozen=True)
@@ -88,7 +107,13 @@ class MissionTracker:
         self.robots = {r.name: RobotRecord(r.name) for r in problem.robots}
         self.ignored = Counter()
         self._event_ids: set[str] = set()
-        self._unknown_robots: set[str] = set()
+        self._repeated: set[str] = set()
+        """Reasons of robot states already counted: heartbeats repeat them every period."""
+        self._latest = 0.0
+        """The latest time any event used reported: dates failures reported without one."""
+        self._failures_at: dict[int, dict[str, int]] = {}
+        """Plan revision -> each robot's failure count when it was set."""
+        self._locations = frozenset(problem.locations())
 
     # --- plans -------------------------------------------------------------------------
 
@@ -108,10 +133,20 @@ class MissionTracker:
             if name not in continued:
                 self.jobs[name] = JobRecord(name, since_revision=revision)
         self.plan, self.revision = schedule, revision
+        self._failures_at[revision] = {name: r.failures for name, r in self.robots.items()}
+
+    def failed_since(self, revision: int) -> frozenset[str]:
+        """Robots that became failed or offline at least once since plan `revision` was set,
+        whether or not they are healthy again. A revision never set (0: before the first
+        plan) counts every failure since the tracker began."""
+        before = self._failures_at.get(revision, {})
+        return frozenset(name for name, r in self.robots.items()
+                         if r.failures > before.get(name, 0))
 
     def extend(self, problem: Problem) -> None:
         """The mission grew to `problem` (jobs added): its new jobs are tracked too."""
         self.problem = problem
+        self._locations = set(problem.locations())
         for job in problem.jobs:
             self.jobs.setdefault(job.name, JobRecord(job.name, since_revision=self.revision))
 
@@ -126,12 +161,17 @@ class MissionTracker:
 
     def record_event(self, event_id: str, kind: EventKind, robot: str, job: str,
                      revision: int, time: float) -> Outcome:
-        """Use one task event of an agent; classify it if it cannot be used."""
-        outcome = self._check_event(event_id, robot, job, revision, time)
+        """Use one task event of an agent; classify it if it cannot be used. Never raises,
+        whatever the arguments."""
+        outcome = self._check_event(event_id, kind, robot, job, revision, time)
+        if outcome is None:
+            kind = EventKind(kind)
+            outcome = self._check_order(event_id, kind, robot, job, time)
         if outcome is not None:
             self.ignored[outcome.ignored] += 1
             return outcome
         self._event_ids.add(event_id)
+        self._latest = max(self._latest, time)
         record = self.jobs[job]
         facts = {EventKind.ARRIVED: record.arrived, EventKind.STARTED: record.started,
                  EventKind.OPERATION_DONE: record.operation_done}
@@ -143,7 +183,7 @@ class MissionTracker:
         if robot in facts[kind] or record.end is not None:
             self.ignored[Ignored.DUPLICATE] += 1
             return Outcome(Ignored.DUPLICATE, f"'{robot}' already reported {kind} for job "
-                                              f"'{job}' (event '{event_id}')")
+                                              f"'{job}' (event {shown(event_id)})")
         facts[kind][robot] = time
         if kind == EventKind.OPERATION_DONE:
             robots = self.plan.jobs[job].robots
@@ -155,58 +195,124 @@ class MissionTracker:
                 return Outcome(job_done=(job, record.end))
         return Outcome()
 
-    def _check_event(self, event_id, robot, job, revision, time) -> Outcome | None:
+    def _check_event(self, event_id, kind, robot, job, revision, time) -> Outcome | None:
+        if not isinstance(event_id, str):
+            return Outcome(Ignored.UNKNOWN, f'invalid event id {shown(event_id)}')
+        what = f'event {shown(event_id)}'      # an id of a megabyte is not logged whole
         if self.plan is None:
-            return Outcome(Ignored.STALE, f"event '{event_id}' arrived before any plan")
+            return Outcome(Ignored.STALE, f'{what} arrived before any plan')
         if event_id in self._event_ids:
-            return Outcome(Ignored.DUPLICATE, f"event '{event_id}' was already received")
-        if robot not in self.robots:
-            return Outcome(Ignored.UNKNOWN, f"event '{event_id}' names unknown robot "
-                                            f"'{robot}'")
-        if job not in self.jobs:
-            return Outcome(Ignored.UNKNOWN, f"event '{event_id}' names unknown job '{job}'")
+            return Outcome(Ignored.DUPLICATE, f'{what} was already received')
+        if not isinstance(kind, str) or kind not in ROBOT_EVENTS:
+            return Outcome(Ignored.UNKNOWN, f'{what} has unknown event kind '
+                                            f'{shown(kind)}')
+        if not isinstance(robot, str) or robot not in self.robots:
+            return Outcome(Ignored.UNKNOWN, f'{what} names unknown robot '
+                                            f'{shown(robot)}')
+        if not isinstance(job, str) or job not in self.jobs:
+            return Outcome(Ignored.UNKNOWN, f'{what} names unknown job '
+                                            f'{shown(job)}')
+        if isinstance(revision, bool) or not isinstance(revision, int):
+            return Outcome(Ignored.UNKNOWN, f'{what} has invalid plan revision '
+                                            f'{shown(revision)}')
         if revision > self.revision:
-            return Outcome(Ignored.UNKNOWN, f"event '{event_id}' follows plan revision "
+            return Outcome(Ignored.UNKNOWN, f'{what} follows plan revision '
                                             f'{revision}, which was never published '
                                             f'(current: {self.revision})')
         if revision < self.jobs[job].since_revision:
-            return Outcome(Ignored.STALE, f"event '{event_id}' follows plan revision "
+            return Outcome(Ignored.STALE, f"{what} follows plan revision "
                                           f"{revision}; revision "
                                           f'{self.jobs[job].since_revision} started '
                                           f"'{job}' afresh")
         if self.jobs[job].aborted:
-            return Outcome(Ignored.STALE, f"event '{event_id}': job '{job}' was aborted and "
+            return Outcome(Ignored.STALE, f"{what}: job '{job}' was aborted and "
                                           'waits for a new revision to be redone')
         if job not in self.plan.jobs:
-            return Outcome(Ignored.STALE, f"event '{event_id}': job '{job}' is not in plan "
+            return Outcome(Ignored.STALE, f"{what}: job '{job}' is not in plan "
                                           f'revision {self.revision}, it was done before')
         if robot not in self.plan.jobs[job].robots:
             if revision < self.revision:
-                return Outcome(Ignored.STALE, f"event '{event_id}' follows plan revision "
+                return Outcome(Ignored.STALE, f"{what} follows plan revision "
                                               f'{revision}; in revision {self.revision} '
                                               f"'{robot}' has no part in job '{job}'")
-            return Outcome(Ignored.UNKNOWN, f"event '{event_id}': robot '{robot}' has no "
+            return Outcome(Ignored.UNKNOWN, f"{what}: robot '{robot}' has no "
                                             f"part in job '{job}'")
-        if not math.isfinite(time) or time < 0:
-            return Outcome(Ignored.UNKNOWN, f"event '{event_id}' has invalid time {time}")
+        if not _time_ok(time):
+            return Outcome(Ignored.UNKNOWN, f'{what} has invalid time '
+                                            f'{shown(time)}')
         return None
 
-    def record_robot_state(self, robot: str, mode: RobotMode, location: str, destination: str,
-                           busy_until: float, current_job: str = '') -> Outcome:
-        if robot not in self.robots:
-            repeated = robot in self._unknown_robots
+    def _check_order(self, event_id, kind, robot, job, time) -> Outcome | None:
+        """An operation reported done must have been reported started, and not later: the
+        job's timeline is built from both (a forged event, or the history of an earlier
+        planner arriving after this one's first plan, can break this)."""
+        if kind != EventKind.OPERATION_DONE:
+            return None
+        what = f'event {shown(event_id)}'
+        started = self.jobs[job].started.get(robot)
+        if started is None:
+            return Outcome(Ignored.UNKNOWN, f"{what}: '{robot}' reports "
+                                            f"operation_done for job '{job}' without having "
+                                            'reported started')
+        if time < started:
+            return Outcome(Ignored.UNKNOWN, f"{what}: '{robot}' reports "
+                                            f'operation_done at t={float(time):g} before it '
+                                            f"started at t={float(started):g} (job '{job}')")
+        return None
+
+    def record_robot_state(self, robot: str, mode: str, location: str, destination: str,
+                           busy_until: float, current_job: str = '',
+                           at: float | None = None) -> Outcome:
+        """Use a robot's state report (or heartbeat) observed at schedule time `at`.
+
+        A report that turns a healthy robot failed or offline counts a failure at `at` (by
+        default: the latest time any event reported). A `busy_until` that is not a finite
+        non-negative number reads as NaN (not said). A report naming an unknown robot or
+        place is ignored, and counted once however often it repeats. Never raises.
+        """
+        problem = self._state_problem(robot, mode, location, destination, current_job)
+        if problem is not None:
+            repeated = problem in self._repeated
             if not repeated:
-                self._unknown_robots.add(robot)
+                self._repeated.add(problem)
                 self.ignored[Ignored.UNKNOWN] += 1
-            return Outcome(Ignored.UNKNOWN, f"state of unknown robot '{robot}'",
-                           repeated=repeated)
-        self.robots[robot] = RobotRecord(robot, RobotMode(mode), location, destination, busy_until,
-                                         current_job, True)
+            return Outcome(Ignored.UNKNOWN, problem, repeated=repeated)
+        record = self.robots[robot]
+        was_healthy = record.healthy
+        record.mode, record.location, record.destination = mode, location, destination
+        record.busy_until = busy_until if _time_ok(busy_until) else math.nan
+        record.current_job, record.reported = current_job, True
+        self._count_failure(record, was_healthy, at)
         return Outcome()
 
-    def mark_offline(self, robot: str) -> None:
-        """Its heartbeat was lost: treated as failed until it reports again."""
-        self.robots[robot].mode = RobotMode.OFFLINE
+    def _state_problem(self, robot, mode, location, destination, current_job) -> str | None:
+        if not isinstance(robot, str) or robot not in self.robots:
+            return f'state of unknown robot {shown(robot)}'
+        fields = {'mode': mode, 'location': location, 'destination': destination,
+                  'current job': current_job}
+        for what, value in fields.items():
+            if not isinstance(value, str):
+                return f"'{robot}' reports a {what} that is not text: {shown(value)}"
+        for what, value in (('location', location), ('destination', destination)):
+            if value and value not in self._locations:
+                return f"'{robot}' reports unknown {what} {shown(value)}"
+        return None
+
+    def mark_offline(self, robot: str, at: float | None = None) -> Outcome:
+        """Its heartbeat was lost (observed at schedule time `at`): treated as failed until it
+        reports again. Counts a failure like `record_robot_state`."""
+        if not isinstance(robot, str) or robot not in self.robots:
+            return Outcome(Ignored.UNKNOWN, f'heartbeat loss of unknown robot {shown(robot)}')
+        record = self.robots[robot]
+        was_healthy = record.healthy
+        record.mode = RobotMode.OFFLINE
+        self._count_failure(record, was_healthy, at)
+        return Outcome()
+
+    def _count_failure(self, record: RobotRecord, was_healthy: bool, at) -> None:
+        if was_healthy and not record.healthy:
+            record.failures += 1
+            record.last_failure_at = at if _time_ok(at) else self._latest
 
     # --- what the reports add up to ------------------------------------------------------
 
@@ -330,5 +436,90 @@ class MissionTracker:
                 location, free_at = r.destination, max(Fraction(arrival), now_f)
             else:
                 location, free_at = r.location or None, now_f
-            robots[name] = RobotState(name, r.healthy, location, free_at)
-        return ExecutionState(now_f, self.done, running, robots)
+            failed_at = None if r.last_failure_at is None else Fraction(r.last_failure_at)
+            robots[name] = RobotState(name, r.healthy, location, free_at, failed_at)
+        started = {name: Fraction(self.jobs[name].start) for name in self.done}
+        return ExecutionState(now_f, self.done, running, robots, started)
+
+    def violations(self) -> list[str]:
+        """Every way the executed timeline (the jobs done so far, as they ran) breaks the
+        mission's problem: precedence, holding arcs, staffing (plans, distinct able robots),
+        robots on two jobs at once, travel and release times. Empty: it is valid.
+
+        A mission run across several plan revisions is checked against the problem as
+        posed, with two allowances for what execution legitimately changes: operations last
+        as long as the agents reported (delay faults lengthen or shorten them), and travel
+        between two consecutive jobs of a robot is held to the shortest route between their
+        locations, since the robot may have passed through the location of a job that was
+        aborted or left out of a new revision on its way.
+        """
+        executed = self.executed_schedule()
+        done = set(executed.jobs)
+        messages = []
+        for before, after in self.problem.precedence:
+            if after in done and before not in done:
+                messages.append(f"job '{after}' is done but '{before}', which must complete "
+                                'before it, is not')
+        for source, target, _ in self.problem.holding:
+            if target in done and source not in done:
+                messages.append(f"job '{target}' is done but '{source}', which holds into "
+                                'it, is not')
+        return messages + validate(self._as_executed(executed), executed)
+
+    def _as_executed(self, executed: Schedule) -> Problem:
+        """The problem restricted to the executed jobs, operations free of duration and
+        distances relaxed to shortest routes where the direct one does not fit."""
+        p = self.problem
+        done = set(executed.jobs)
+        locomote = p.locomote
+        return dataclasses.replace(
+            p, jobs=tuple(j for j in p.jobs if j.name in done),
+            precedence=tuple((a, b) for a, b in p.precedence if a in done and b in done),
+            holding=tuple((a, b, q) for a, b, q in p.holding if a in done and b in done),
+            robot_types={name: {q: (t if q == locomote else Fraction(0))
+                                for q, t in times.items()}
+                         for name, times in p.robot_types.items()},
+            time_overrides=dict.fromkeys(p.time_overrides, Fraction(0)),
+            distances=self._relaxed_distances(executed), fixed={}, panels=(),
+            name=f'{p.name} as executed')
+
+    def _relaxed_distances(self, executed: Schedule) -> dict:
+        p = self.problem
+        legs = set()
+        for robot in p.robots:
+            jobs = [executed.jobs[j] for j in executed.sequences.get(robot.name, ())]
+            where = robot.start_location
+            free = robot.release_time
+            for a in jobs:
+                here = p.job(a.job).location
+                if where is not None and a.start < free + p.travel(robot.name, where, here):
+                    legs.add((where, here))
+                where, free = here, a.end
+        distances = dict(p.distances)
+        nearest = {}
+        for a, b in legs:
+            if a not in nearest:
+                nearest[a] = _shortest_distances(p, a)
+            distances[a, b] = distances[b, a] = nearest[a][b]
+        return distances
+
+
+def _shortest_distances(problem: Problem, source: str) -> dict[str, Fraction]:
+    """Dijkstra over the complete graph of locations (distances need not be metric)."""
+    places = problem.locations()
+    best = {place: problem.distance(source, place) for place in places}
+    todo = set(places) - {source}
+    while todo:
+        nearest = min(todo, key=best.__getitem__)
+        todo.remove(nearest)
+        for place in todo:
+            via = best[nearest] + problem.distance(nearest, place)
+            if via < best[place]:
+                best[place] = via
+    return best
+
+
+def _time_ok(value) -> bool:
+    """A reported time: a number within [0, MAX_REPORTED_TIME] (not NaN, not infinite)."""
+    return (isinstance(value, numbers.Real) and not isinstance(value, bool)
+            and 0 <= value <= MAX_REPORTED_TIME)

@@ -1,4 +1,4 @@
-"""An independent check of a schedule against the problem of SPEC §1, in exact arithmetic.
+"""An independent check of a schedule against the model of docs/model.md, in exact arithmetic.
 
 It shares no code with the solvers on purpose: a mistake in a solver's model must not hide
 itself by being repeated here. Only the problem and schedule data classes are used, and
