@@ -1,5 +1,6 @@
 """`ros2 run fjsp_planner fleet`: a complete mission exits 0, a bad scenario starts nothing,
-and no node outlives the launcher, whether it is interrupted or killed."""
+no node outlives the launcher, whether it is interrupted or killed, and a node interrupted
+while it starts ends without a traceback."""
 
 import os
 import signal
@@ -130,3 +131,13 @@ jobs:
     assert process.returncode == 2, out + err
     assert "robot 'R-1': its name must be usable in ROS names" in err
     assert not (tmp_path / 'out').exists()
+
+
+def test_a_node_stopped_while_starting_ends_without_a_traceback(fjsp_fleet):
+    fleet = fjsp_fleet()
+    fleet.start_agent('MARC1')
+    # At once: the agent is still importing its modules. It ignores SIGINT until it can
+    # stop cleanly, and is killed after the grace period if it is not there yet.
+    codes = fleet.stop()
+    assert codes['agent_MARC1'] in (0, -signal.SIGKILL), codes
+    assert 'Traceback' not in fleet.log('agent_MARC1')

@@ -154,14 +154,21 @@ def write_node_params(path: Path, node: str, params: dict) -> None:
                                    sort_keys=False))
 
 
-def _die_with_parent(parent: int):
-    """Run in the child between fork and exec: the kernel kills it when the launcher dies."""
+def _prepare_node(parent: int):
+    """What the child runs between fork and exec.
+
+    The kernel kills it when the launcher dies. SIGINT is ignored until the node installs
+    its own handler (every node does first thing; a Python process does not install its
+    default one over an ignored SIGINT): a Ctrl-C that catches a node still importing its
+    modules would otherwise end it with a traceback; ignored, the node is killed after the
+    grace period instead."""
     prctl = ctypes.CDLL(None, use_errno=True).prctl
 
     def prepare():
         prctl(_PR_SET_PDEATHSIG, signal.SIGKILL)
         if os.getppid() != parent:  # the launcher died before the request took effect
             os._exit(1)
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
     return prepare
 
 
@@ -287,7 +294,7 @@ class Fleet:
             process = subprocess.Popen(
                 command, env=self.env, stdin=subprocess.DEVNULL,
                 stdout=subprocess.PIPE if stream else log, stderr=subprocess.STDOUT,
-                start_new_session=True, preexec_fn=_die_with_parent(os.getpid()))
+                start_new_session=True, preexec_fn=_prepare_node(os.getpid()))
         finally:
             if not stream:
                 log.close()
