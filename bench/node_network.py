@@ -1,9 +1,10 @@
 """Benchmark of the node network on the paper's one-panel mission (prints, never asserts).
 
-For each time scale: planner + four agents started with `ros2 run` in a private domain;
-plan publish -> every agent follows it (latency, from message stamps); per-node CPU and
-resident memory during the mission and at idle afterwards (from /proc); executed vs planned
-makespan in schedule units and the wall-clock overhead of the mission.
+For each time scale: planner + four agents started by the fleet launcher
+(`fjsp_planner.fleet.Fleet`) in a private domain; plan publish -> every agent follows it
+(latency, from message stamps); per-node CPU and resident memory during the mission and at
+idle afterwards (from /proc); executed vs planned makespan in schedule units and the
+wall-clock overhead of the mission.
 
 Run from the repository with the workspace sourced:
     source ros2_ws/env.sh && python bench/node_network.py [--time-scales 0.02 0.1]
@@ -11,17 +12,12 @@ Run from the repository with the workspace sourced:
 
 import argparse
 import os
-import signal
-import subprocess
 import sys
 import tempfile
-import threading
 import time
 from contextlib import closing
 from pathlib import Path
 
-import rclpy
-from rclpy.executors import SingleThreadedExecutor
 from rclpy.time import Time
 
 from fjsp_common.contract import (
@@ -29,13 +25,14 @@ from fjsp_common.contract import (
     LATCHED_QOS,
     MISSION_STATUS_TOPIC,
     PLAN_TOPIC,
+    ROBOT_STATES_QOS,
     ROBOT_STATES_TOPIC,
     TASK_EVENTS_TOPIC,
 )
 from fjsp_msgs.msg import MissionStatus, Plan, RobotState, TaskEvent
+from fjsp_planner.fleet import Fleet, Listener
 
-ROBOTS = (('Assembler', 'assembler_agent'), ('LSMS', 'lsms_agent'),
-          ('MARC1', 'marc_agent'), ('MARC2', 'marc_agent'))
+LOCALHOST = {'ROS_AUTOMATIC_DISCOVERY_RANGE': 'LOCALHOST'}
 TICKS = os.sysconf('SC_CLK_TCK')
 PAGE = os.sysconf('SC_PAGE_SIZE')
 
@@ -49,34 +46,24 @@ def rss_mb(pid) -> float:
     return int(Path(f'/proc/{pid}/statm').read_text().split()[1]) * PAGE / 1e6
 
 
-class Recorder:
+def fleet(domain, logs, time_scale=None, panels=None, **planner) -> Fleet:
+    """The paper's fleet (planner and four generic agents, no monitor) in `domain`."""
+    return Fleet(domain=domain, out=logs, env=LOCALHOST, time_scale=time_scale,
+                 panels=panels, planner=planner)
+
+
+class Recorder(Listener):
     def __init__(self, domain):
-        self.context = rclpy.Context()
-        rclpy.init(context=self.context, domain_id=domain)
-        self.node = rclpy.create_node('bench_recorder', context=self.context)
+        super().__init__(domain, name='bench_recorder', discovery_range='LOCALHOST')
         self.plan = None
         self.status = None
         self.followed = {}
         self.heard = set()
         self.last_job_done = None
-        self.node.create_subscription(Plan, PLAN_TOPIC, self.on_plan, LATCHED_QOS)
-        self.node.create_subscription(MissionStatus, MISSION_STATUS_TOPIC, self.on_status,
-                                      LATCHED_QOS)
-        self.node.create_subscription(RobotState, ROBOT_STATES_TOPIC, self.on_robot,
-                                      LATCHED_QOS)
-        self.node.create_subscription(TaskEvent, TASK_EVENTS_TOPIC, self.on_event, EVENTS_QOS)
-        self.executor = SingleThreadedExecutor(context=self.context)
-        self.executor.add_node(self.node)
-        self.thread = threading.Thread(target=self.spin, daemon=True)
-        self.thread.start()
-
-    def spin(self):
-        while self.context.ok():
-            try:
-                self.executor.spin_once(timeout_sec=0.1)
-            except Exception:  # noqa: BLE001  the context went down between checks
-                if self.context.ok():
-                    raise
+        self.subscribe(Plan, PLAN_TOPIC, LATCHED_QOS, self.on_plan)
+        self.subscribe(MissionStatus, MISSION_STATUS_TOPIC, LATCHED_QOS, self.on_status)
+        self.subscribe(RobotState, ROBOT_STATES_TOPIC, ROBOT_STATES_QOS, self.on_robot)
+        self.subscribe(TaskEvent, TASK_EVENTS_TOPIC, EVENTS_QOS, self.on_event)
 
     def on_plan(self, msg):
         self.plan = msg
@@ -100,61 +87,19 @@ class Recorder:
                 raise TimeoutError
             time.sleep(0.02)
 
-    def close(self):
-        self.executor.shutdown(timeout_sec=1.0)
-        self.node.destroy_node()
-        rclpy.try_shutdown(context=self.context)
-
-
-class Nodes:
-    """Nodes started with `ros2 run` in one domain, each logging to `logs/<name>.log`;
-    interrupted (then killed if need be) on leaving the `with` block."""
-
-    def __init__(self, domain, logs):
-        self.env = dict(os.environ, ROS_DOMAIN_ID=str(domain),
-                        ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
-        self.logs = logs
-        self.processes = {}
-
-    def start(self, name, package, executable, *params):
-        command = ['ros2', 'run', package, executable, '--ros-args', '-r', f'__node:={name}']
-        for key, value in params:
-            command += ['-p', f'{key}:={value}']
-        with (self.logs / f'{name}.log').open('w') as log:
-            self.processes[name] = subprocess.Popen(
-                command, env=self.env, stdout=log, stderr=subprocess.STDOUT,
-                start_new_session=True)
-
-    def start_agents(self):
-        for robot, executable in ROBOTS:
-            self.start(f'{robot.lower()}_agent', 'robot_agents', executable,
-                       ('robot_name', robot))
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        for p in self.processes.values():
-            if p.poll() is None:
-                os.killpg(p.pid, signal.SIGINT)
-        for p in self.processes.values():
-            try:
-                p.wait(timeout=5)
-            except subprocess.TimeoutExpired:
-                os.killpg(p.pid, signal.SIGKILL)
-                p.wait()
-
 
 def run(time_scale, domain, logs):
-    with Nodes(domain, logs) as nodes, closing(Recorder(domain)) as recorder:
+    with fleet(domain, logs, time_scale) as nodes, closing(Recorder(domain)) as recorder:
         processes = nodes.processes
+        robots = [r.name for r in nodes.problem.robots]
         # The recorder must hear each agent before the plan exists: a late-matched recorder
         # would only get the latest (heartbeat) state, not the transition it measures.
-        nodes.start_agents()
-        recorder.wait(lambda: len(recorder.heard) == len(ROBOTS), 30)
-        nodes.start('planner', 'fjsp_planner', 'planner_node', ('time_scale', time_scale))
+        for robot in robots:
+            nodes.start_agent(robot)
+        recorder.wait(lambda: len(recorder.heard) == len(robots), 30)
+        nodes.start_planner()
         recorder.wait(lambda: recorder.plan is not None, 60)
-        recorder.wait(lambda: len(recorder.followed) == len(ROBOTS), 30)
+        recorder.wait(lambda: len(recorder.followed) == len(robots), 30)
         published = Time.from_msg(recorder.plan.stamp)
         latency = {r: (t - published).nanoseconds / 1e6 for r, t in recorder.followed.items()}
         mission_start = Time.from_msg(recorder.plan.mission_start).nanoseconds / 1e9
@@ -173,7 +118,7 @@ def run(time_scale, domain, logs):
         planned = recorder.plan.makespan
         executed = recorder.status.projected_makespan
         wall = recorder.last_job_done - mission_start
-        print(f'\n== time_scale {time_scale} s/unit ({len(ROBOTS)} agents, planner) ==')
+        print(f'\n== time_scale {time_scale} s/unit ({len(robots)} agents, planner) ==')
         print('plan publish -> agent follows it (ms): '
               + ', '.join(f'{r} {ms:.1f}' for r, ms in sorted(latency.items()))
               + f'; all agents: {max(latency.values()):.1f}')

@@ -1,6 +1,6 @@
 """Re-plan latency over the node network: fault injected -> every agent follows the new plan.
 
-For each panel count: planner + four agents started with `ros2 run` in a private domain,
+For each panel count: planner + four agents started by the fleet launcher in a private domain,
 missions run one after another; during each, a robot is failed, or the failed one recovered,
 at random moments (seeded) through its `inject_fault` service. Latency is measured from
 sending the request to the last agent (all four, the failed one included) reporting the new
@@ -23,7 +23,7 @@ import time
 from contextlib import closing
 from pathlib import Path
 
-from node_network import ROBOTS, Nodes, Recorder
+from node_network import Recorder, fleet
 
 from fjsp_common.contract import INJECT_FAULT_SERVICE
 from fjsp_msgs.msg import MissionStatus
@@ -39,13 +39,13 @@ PLAN_LIMIT = {1: 5.0, 2: 10.0, 5: 15.0}
 class FaultRecorder(Recorder):
     """Also keeps when each robot was first heard following each revision, and the plans."""
 
-    def __init__(self, domain):
+    def __init__(self, domain, robots):
         self.following = {}
         self.plans = {}
         super().__init__(domain)
         self.clients = {robot: self.node.create_client(InjectFault,
                                                        f'{robot}/{INJECT_FAULT_SERVICE}')
-                        for robot, _ in ROBOTS}
+                        for robot in robots}
 
     def on_plan(self, msg):
         self.plans[msg.revision] = msg
@@ -58,8 +58,8 @@ class FaultRecorder(Recorder):
     def inject(self, robot, fault) -> tuple[float, bool, str]:
         """Send the request; returns when it was sent and the agent's answer.
 
-        Clients made once up front, not `faults.inject_fault`, which makes a client per
-        call: its service discovery (5-90 ms) would count in every latency."""
+        Clients made once up front, not `faults.inject_fault`, which makes a node and a
+        client per call: their discovery (5-90 ms) would count in every latency."""
         sent = time.monotonic()
         future = self.clients[robot].call_async(InjectFault.Request(fault=fault))
         self.wait(future.done, 10)
@@ -68,13 +68,16 @@ class FaultRecorder(Recorder):
 
 
 def run_mission(panels, args, domain, logs, rng, rows):
-    with Nodes(domain, logs) as nodes, closing(FaultRecorder(domain)) as recorder:
-        nodes.start_agents()
-        recorder.wait(lambda: len(recorder.heard) == len(ROBOTS), 30)
-        nodes.start('planner', 'fjsp_planner', 'planner_node', ('panels', panels),
-                    ('time_scale', TIME_SCALE[panels]), ('time_limit', PLAN_LIMIT[panels]),
-                    ('replan_time_limit', args.replan_limit or REPLAN_LIMIT[panels]),
-                    ('workers', args.workers))
+    nodes = fleet(domain, logs, TIME_SCALE[panels], panels=panels,
+                  time_limit=PLAN_LIMIT[panels],
+                  replan_time_limit=args.replan_limit or REPLAN_LIMIT[panels],
+                  workers=args.workers)
+    robots = [r.name for r in nodes.problem.robots]
+    with nodes, closing(FaultRecorder(domain, robots)) as recorder:
+        for robot in robots:
+            nodes.start_agent(robot)
+        recorder.wait(lambda: len(recorder.heard) == len(robots), 30)
+        nodes.start_planner()
         for client in recorder.clients.values():
             if not client.wait_for_service(timeout_sec=30):
                 raise TimeoutError('an agent does not serve inject_fault')
@@ -89,7 +92,7 @@ def run_mission(panels, args, domain, logs, rng, rows):
             if status.state != MissionStatus.STATE_EXECUTING:
                 continue
             if failed is None:
-                robot, fault, kind = rng.choice(ROBOTS)[0], InjectFault.Request.FAULT_FAIL, 'fail'
+                robot, fault, kind = rng.choice(robots), InjectFault.Request.FAULT_FAIL, 'fail'
             else:
                 robot, fault, kind = failed, InjectFault.Request.FAULT_RECOVER, 'recover'
             before = max(recorder.plans)
@@ -100,13 +103,13 @@ def run_mission(panels, args, domain, logs, rng, rows):
             failed = robot if kind == 'fail' else None
             try:
                 recorder.wait(lambda before=before: max(recorder.plans) > before and all(
-                    (r, max(recorder.plans)) in recorder.following for r, _ in ROBOTS), 30)
+                    (r, max(recorder.plans)) in recorder.following for r in robots), 30)
             except TimeoutError:
                 rows.append((kind, robot, None, None))
                 print(f'  {kind} {robot}: no new revision followed by every agent in 30 s')
                 continue
             revision = max(recorder.plans)
-            latency = max(recorder.following[r, revision] for r, _ in ROBOTS) - sent
+            latency = max(recorder.following[r, revision] for r in robots) - sent
             plan = recorder.plans[revision]
             rows.append((kind, robot, latency, plan))
             print(f'  {kind:<8}{robot:<10} revision {revision:>2}: {latency * 1000:7.0f} ms, '

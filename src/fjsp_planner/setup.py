@@ -12,6 +12,7 @@ setup(
         ('share/ament_index/resource_index/packages', ['resource/' + package_name]),
         ('share/' + package_name, ['package.xml']),
         ('share/' + package_name + '/scenarios', glob('../../config/scenarios/*.yaml')),
+        ('share/' + package_name + '/params', glob('../../config/params/*.yaml')),
     ],
     install_requires=['setuptools'],
     zip_safe=True,
@@ -26,6 +27,7 @@ setup(
             'monitor_node = fjsp_planner.nodes.monitor:main',
             'inject_fault = fjsp_planner.faults:main',
             'mission = fjsp_planner.missions:main',
+            'fleet = fjsp_planner.fleet:main',
         ],
     },
 )

@@ -11,9 +11,11 @@ ARRIVED, STARTED, DONE, ABORTED = (EventKind.ARRIVED, EventKind.STARTED,
                                    EventKind.OPERATION_DONE, EventKind.ABORTED)
 
 
-def task(job, start, duration, end=None, leg=0.0, co=(), preds=(), held=False, location=None):
-    return Task(job=job, operation_type=0, location=location or job, travel_start=start - leg,
-                arrival=start, start=start, operation_end=start + duration,
+def task(job, start, duration, end=None, leg=0.0, co=(), preds=(), held=False, location=None,
+         arrival=None):
+    arrival = start if arrival is None else arrival
+    return Task(job=job, operation_type=0, location=location or job, travel_start=arrival - leg,
+                arrival=arrival, start=start, operation_end=start + duration,
                 end=end if end is not None else start + duration, co_workers=tuple(co),
                 predecessors=tuple(preds), held_into_next=held)
 
@@ -45,7 +47,8 @@ def test_solo_sequence_travels_and_works_in_logical_time():
 
 def test_job_waits_for_co_workers_and_predecessors():
     r = RobotExecution('A')
-    plan(r, 1, [task('J2', 4, 1, co=['B'], preds=['J1'])], {'J1': {'B'}, 'J2': {'A', 'B'}})
+    plan(r, 1, [task('J2', 4, 1, co=['B'], preds=['J1'], arrival=0)],
+         {'J1': {'B'}, 'J2': {'A', 'B'}})
     assert kinds(r.step(3)) == [(ARRIVED, 'J2', 0)]
     assert r.mode == RobotMode.WAITING
     r.operation_done('B', 'J1', 3.0, 1)   # J1's only robot is done: J1 is complete at 3
@@ -383,3 +386,16 @@ def test_running_held_job_after_a_done_jig_job_is_continued():
          {'Ja': {'A'}, 'Aa': {'A', 'B'}}, now=6, continued={'Ja', 'Aa'})
     assert r.mode == RobotMode.WORKING and r.current_job == 'Aa'
     assert kinds(r.step(10.1)) == [(DONE, 'Aa', 10)]
+
+
+def test_first_leg_leaves_from_the_start_location_once_released():
+    # The plan starts A at its start location, released at 3, with a 2-unit leg to J1.
+    r = RobotExecution('A')
+    plan(r, 1, [task('J1', 5, 1, leg=2)])
+    assert r.step(1) == []
+    assert r.mode == RobotMode.TRAVELLING and r.busy_until == pytest.approx(5)
+    assert kinds(r.step(7)) == [(ARRIVED, 'J1', 5), (STARTED, 'J1', 5), (DONE, 'J1', 6)]
+    # A robot that may start anywhere has a plan without a first leg: there at once.
+    r = RobotExecution('B')
+    plan(r, 1, [task('J1', 0, 1)])
+    assert kinds(r.step(0)) == [(ARRIVED, 'J1', 0), (STARTED, 'J1', 0)]

@@ -1,28 +1,15 @@
-"""Fixtures of the integration tests; the harness itself is in harness.py."""
+"""Integration tests run real node processes through the public harness,
+`fjsp_planner.testing` (docs/testing.md), which needs the built and sourced workspace."""
+
+import os
+import shutil
 
 import pytest
-from harness import Launcher, Observer, private_domain
 
+if shutil.which('ros2') is None or 'AMENT_PREFIX_PATH' not in os.environ:
+    pytest.exit('integration tests need the built workspace: run `bash ros2_ws/test.sh`, or '
+                '`bash ros2_ws/bootstrap.sh && source ros2_ws/env.sh` before pytest', 4)
 
-@pytest.fixture
-def domain():
-    with private_domain() as domain:
-        yield domain
-
-
-@pytest.fixture
-def launcher(domain, tmp_path):
-    launcher = Launcher(domain, tmp_path)
-    try:
-        yield launcher
-    finally:
-        launcher.stop()
-
-
-@pytest.fixture
-def observer(domain):
-    observer = Observer(domain)
-    try:
-        yield observer
-    finally:
-        observer.close()
+# The harness's fixture, as a user's conftest gets it with pytest_plugins (which pytest
+# allows only in the top-level conftest, and the core tests need no ROS).
+from fjsp_planner.testing import fjsp_fleet, ros_domain  # noqa: E402, F401

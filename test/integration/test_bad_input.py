@@ -1,10 +1,13 @@
 """Bad parameters and command lines: a clear message naming the item, a non-zero exit code,
 no traceback and no hang."""
 
+import os
 import subprocess
+from pathlib import Path
 
 import pytest
-from harness import SCENARIO
+
+SCENARIO = Path(__file__).resolve().parents[2] / 'config' / 'scenarios' / 'solar_panel.yaml'
 
 
 @pytest.mark.parametrize(('command', 'code', 'message'), [
@@ -27,10 +30,22 @@ from harness import SCENARIO
     (['run', 'no_such_package', 'x'], 1, "Package 'no_such_package' not found"),
     (['run', 'robot_agents', 'no_such_agent'], 1, 'No executable found'),
     (['topic', 'list'], 2, 'not provided by this front end'),
+    (['run', 'fjsp_planner', 'fleet'], 2, 'the following arguments are required: scenario'),
+    (['run', 'fjsp_planner', 'fleet', 'no_such_scenario'], 2,
+     'no_such_scenario: no such scenario file (installed: antenna.yaml, solar_panel.yaml, '
+     'truss.yaml)'),
+    (['run', 'fjsp_planner', 'fleet', 'truss', '--panels', '0'], 2,
+     'argument --panels: must be > 0, got 0'),
+    (['run', 'fjsp_planner', 'fleet', 'truss', '--time-scale', 'fast'], 2,
+     "argument --time-scale: expected a number > 0, got 'fast'"),
+    (['run', 'fjsp_planner', 'fleet', 'truss', '--params-file', '/no/such.yaml'], 2,
+     '/no/such.yaml: cannot read parameters file: No such file or directory'),
 ])
-def test_bad_input_is_refused_clearly(launcher, command, code, message):
-    done = subprocess.run(['ros2', *command], env=launcher.env, capture_output=True,
-                          text=True, timeout=30)
+def test_bad_input_is_refused_clearly(command, code, message, ros_domain):
+    env = dict(os.environ, ROS_DOMAIN_ID=str(ros_domain),
+               ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
+    done = subprocess.run(['ros2', *command], env=env, capture_output=True, text=True,
+                          timeout=30)
     output = done.stdout + done.stderr
     assert done.returncode == code, output
     assert message in output

@@ -2,8 +2,7 @@
 
 import copy
 import time
-
-from harness import ROBOTS
+from pathlib import Path
 
 from fjsp_common.contract import (
     EVENTS_QOS,
@@ -14,22 +13,23 @@ from fjsp_common.contract import (
 )
 from fjsp_msgs.msg import Plan, RobotState, TaskEvent
 
+SCENARIO = Path(__file__).resolve().parents[2] / 'config' / 'scenarios' / 'solar_panel.yaml'
 
-def test_bad_messages_are_ignored_and_counted(launcher, observer):
+
+def test_bad_messages_are_ignored_and_counted(fjsp_fleet):
     # Slow enough (32 units * 0.15 s) that the bad messages land mid-mission.
-    launcher.start_planner(time_scale=0.15)
-    for robot, _ in ROBOTS:
-        launcher.start_agent(robot)
+    fleet = fjsp_fleet(SCENARIO, time_scale=0.15).start()
+    observer = fleet.observer
     # Each writer is discovered on its own: the planner's job-done may come before any
     # agent's event, so wait for both kinds.
-    observer.wait_for(lambda o: {TaskEvent.KIND_JOB_DONE, TaskEvent.KIND_STARTED}
+    fleet.wait_for(lambda o: {TaskEvent.KIND_JOB_DONE, TaskEvent.KIND_STARTED}
                       <= {e.kind for e in o.events}, 30, 'the first job to start and complete')
-    plans = observer.publisher(Plan, PLAN_TOPIC, LATCHED_QOS)
-    events = observer.publisher(TaskEvent, TASK_EVENTS_TOPIC, EVENTS_QOS)
-    states = observer.publisher(RobotState, ROBOT_STATES_TOPIC, LATCHED_QOS)
+    plans = observer.node.create_publisher(Plan, PLAN_TOPIC, LATCHED_QOS)
+    events = observer.node.create_publisher(TaskEvent, TASK_EVENTS_TOPIC, EVENTS_QOS)
+    states = observer.node.create_publisher(RobotState, ROBOT_STATES_TOPIC, LATCHED_QOS)
     # Subscribers: planner, four agents and this observer (plan, events); planner and
     # observer (states). Latched writers would deliver late anyway, but within the wait.
-    observer.wait_for(lambda o: plans.get_subscription_count() >= 6
+    fleet.wait_for(lambda o: plans.get_subscription_count() >= 6
                       and events.get_subscription_count() >= 6
                       and states.get_subscription_count() >= 2, 15,
                       'the nodes to discover the test publishers')
@@ -52,20 +52,20 @@ def test_bad_messages_are_ignored_and_counted(launcher, observer):
         states.publish(RobotState(robot='R2D2', mode=RobotState.MODE_IDLE))
         time.sleep(0.2)
 
-    observer.wait_for(lambda o: o.status.ignored_stale >= 1 and o.status.ignored_duplicate >= 1
+    fleet.wait_for(lambda o: o.status.ignored_stale >= 1 and o.status.ignored_duplicate >= 1
                       and o.status.ignored_unknown >= 3, 15,
                       'the planner to count 1 stale, 1 duplicate and 3 unknown messages')
-    observer.wait_for(lambda o: o.complete(), 60, 'the mission to complete anyway')
+    fleet.wait_for(lambda o: o.complete(), 60, 'the mission to complete anyway')
     status = observer.status
     assert (status.ignored_stale, status.ignored_duplicate, status.ignored_unknown) == (1, 1, 3)
     assert status.jobs_done == 12
-    planner = launcher.log('planner')
+    planner = fleet.log('planner')
     assert 'ignoring stale plan revision 0' in planner
     assert f"event '{original.event_id}' was already received" in planner
     assert "unknown robot 'R2D2'" in planner
     assert "unknown job 'Zz'" in planner
     assert "agent of robot 'R2D2' is running, but scenario 'solar_panel' has no such robot" \
         in planner
-    for robot, _ in ROBOTS:
-        assert 'ignoring stale plan revision 0' in launcher.log(f'{robot.lower()}_agent')
+    for robot in ('Assembler', 'LSMS', 'MARC1', 'MARC2'):
+        assert 'ignoring stale plan revision 0' in fleet.log(f'agent_{robot}')
         assert observer.robots[robot].plan_revision == 1

@@ -3,24 +3,27 @@ request or redid work before it was fixed."""
 
 import threading
 import time
-
-from harness import ROBOTS
+from pathlib import Path
 
 from fjsp_msgs.msg import MissionStatus, TaskEvent
 from fjsp_planner.faults import FaultError, inject_fault
 
-
-def start(launcher, observer, **planner):
-    launcher.start_planner(time_scale=0.15, **planner)
-    for robot, _ in ROBOTS:
-        launcher.start_agent(robot)
-    observer.wait_for(lambda o: o.status is not None and o.status.jobs_done >= 2, 40,
-                      'the mission under way')
+SCENARIO = Path(__file__).resolve().parents[2] / 'config' / 'scenarios' / 'solar_panel.yaml'
+ROBOTS = ('Assembler', 'LSMS', 'MARC1', 'MARC2')
 
 
-def test_a_burst_of_fault_requests_is_answered_every_one(launcher, observer):
-    launcher.start_agent('LSMS')
-    observer.wait_for(lambda o: 'LSMS' in o.robots, 20, 'the LSMS agent')
+def start(fjsp_fleet, **planner):
+    fleet = fjsp_fleet(SCENARIO, time_scale=0.15, planner=planner).start(monitor=False)
+    fleet.wait_for(lambda o: o.status is not None and o.status.jobs_done >= 2, 40,
+                   'the mission under way')
+    return fleet, fleet.observer
+
+
+def test_a_burst_of_fault_requests_is_answered_every_one(fjsp_fleet):
+    fleet = fjsp_fleet(SCENARIO)
+    observer = fleet.observer
+    fleet.start_agent('LSMS')
+    fleet.wait_for(lambda o: 'LSMS' in o.robots, 20, 'the LSMS agent')
     answers, errors = [], []
 
     def call():
@@ -39,51 +42,51 @@ def test_a_burst_of_fault_requests_is_answered_every_one(launcher, observer):
     assert all('has no operation left to do' in e for e in errors), set(errors)
 
 
-def test_failure_and_recovery_at_once_do_not_hang_the_mission(launcher, observer):
-    start(launcher, observer)
+def test_failure_and_recovery_at_once_do_not_hang_the_mission(fjsp_fleet):
+    fleet, observer = start(fjsp_fleet)
     revision = observer.status.plan_revision
     inject_fault('MARC1', 'fail', node=observer.node)
     inject_fault('MARC1', 'recover', node=observer.node)
-    observer.wait_for(lambda o: o.status.plan_revision > revision, 15,
+    fleet.wait_for(lambda o: o.status.plan_revision > revision, 15,
                       'a re-plan giving the recovered MARC1 its tasks again')
-    observer.wait_for(lambda o: o.complete(), 60, 'the mission to complete')
+    fleet.wait_for(lambda o: o.complete(), 60, 'the mission to complete')
     assert any('failed and recovered' in r or "'MARC1'" in r
                for p in observer.plans for r in p.reasons)
 
 
-def test_a_restarted_agent_is_believed(launcher, observer):
+def test_a_restarted_agent_is_believed(fjsp_fleet):
     """Its event ids must not repeat its previous process's, or its facts are dropped as
     duplicates and the mission stalls."""
-    launcher.start_planner(time_scale=0.5, start_delay=1.0)
-    for robot, _ in ROBOTS:
-        launcher.start_agent(robot)
+    fleet = fjsp_fleet(SCENARIO, time_scale=0.5, planner={'start_delay': 1.0}).start(
+        monitor=False)
+    observer = fleet.observer
     # Killed on its first job, the LSMS's next process redoes it from scratch.
-    observer.wait_for(lambda o: 'LSMS' in o.robots and o.robots['LSMS'].current_job == 'M1',
+    fleet.wait_for(lambda o: 'LSMS' in o.robots and o.robots['LSMS'].current_job == 'M1',
                       40, 'the LSMS on its first job')
-    launcher.kill('lsms_agent')
-    launcher.start_agent('LSMS')
-    observer.wait_for(lambda o: o.complete(), 90, 'the mission to complete')
+    fleet.kill('agent_LSMS')
+    fleet.start_agent('LSMS')
+    fleet.wait_for(lambda o: o.complete(), 90, 'the mission to complete')
     ids = [e.event_id for e in observer.events if e.robot == 'LSMS']
     assert len(ids) == len(set(ids))
 
 
-def test_a_restarted_agent_does_not_flap(launcher, observer):
-    start(launcher, observer, heartbeat_timeout=1.0)
-    launcher.kill('lsms_agent')
-    observer.wait_for(lambda o: "robot 'LSMS' offline" in ' '.join(o.status.blocked_reasons
+def test_a_restarted_agent_does_not_flap(fjsp_fleet):
+    fleet, observer = start(fjsp_fleet, heartbeat_timeout=1.0)
+    fleet.kill('agent_LSMS')
+    fleet.wait_for(lambda o: "robot 'LSMS' offline" in ' '.join(o.status.blocked_reasons
                                                                   + o.status.warnings), 15,
                       'LSMS declared offline')
-    launcher.start_agent('LSMS')
-    observer.wait_for(lambda o: o.complete(), 90, 'the mission to complete')
+    fleet.start_agent('LSMS')
+    fleet.wait_for(lambda o: o.complete(), 90, 'the mission to complete')
     # Out once, back once: each a revision at most, not a string of them.
     assert observer.status.plan_revision <= 4, [p.reasons for p in observer.plans]
 
 
-def test_no_robot_is_declared_offline_in_a_quiet_mission(launcher, observer):
-    start(launcher, observer)
-    observer.wait_for(lambda o: o.complete(), 60, 'the mission to complete')
+def test_no_robot_is_declared_offline_in_a_quiet_mission(fjsp_fleet):
+    fleet, observer = start(fjsp_fleet)
+    fleet.wait_for(lambda o: o.complete(), 60, 'the mission to complete')
     time.sleep(2.0)
-    assert 'offline' not in launcher.log('planner')
+    assert 'offline' not in fleet.log('planner')
     assert observer.status.state == MissionStatus.STATE_COMPLETE
     assert observer.status.plan_revision == 1
     done = [e for e in observer.events if e.kind == TaskEvent.KIND_JOB_DONE]

@@ -1,12 +1,16 @@
-"""A whole mission over real processes: planner + the paper's four robots, via `ros2 run`."""
+"""A whole mission over real processes: the planner and the paper's four robots, each played
+by its type-pinning executable (`assembler_agent`, `lsms_agent`, `marc_agent`)."""
+
+from pathlib import Path
 
 import pytest
-from harness import ROBOTS, SCENARIO, Launcher, Observer, executed_timeline, private_domain
 
 from fjsp_msgs.msg import MissionStatus, TaskEvent
-from fjsp_planner.core.scenario import load_scenario
-from fjsp_planner.core.validate import validate
+from fjsp_planner.testing import FleetHarness
 
+SCENARIO = Path(__file__).resolve().parents[2] / 'config' / 'scenarios' / 'solar_panel.yaml'
+PAPER_AGENTS = {'Assembler': 'assembler_agent', 'LSMS': 'lsms_agent', 'MARC1': 'marc_agent',
+                'MARC2': 'marc_agent'}
 MAKESPAN_TOLERANCE = 0.01
 """Executed makespan may exceed the plan by 1 %: agents keep logical time, so the only slack
 is the rounding-up of reported ends (1e-6 units per leg or operation)."""
@@ -15,37 +19,19 @@ is the rounding-up of reported ends (1e-6 units per leg or operation)."""
 @pytest.fixture(scope='module')
 def mission(tmp_path_factory):
     """One mission shared by this module's tests (each check reads the same run)."""
-    with private_domain() as domain:
-        yield from _mission(domain, tmp_path_factory)
-
-
-def _mission(domain, tmp_path_factory):
-    launcher = Launcher(domain, tmp_path_factory.mktemp('mission'))
-    observer = Observer(domain)
-    try:
-        launcher.start_planner()
-        for robot, _ in ROBOTS:
-            launcher.start_agent(robot)
-        observer.wait_for(lambda o: o.complete(), 60, 'the mission to complete')
-        # The last job-done event and the status saying complete may land in either order.
-        observer.wait_for(lambda o: sum(e.kind == TaskEvent.KIND_JOB_DONE
-                                        for e in o.events) >= 12, 5, 'every job-done event')
-        # Each agent's event history reaches this observer when its writer is discovered.
-        parts = {(r.robot, t.job) for r in observer.plans[-1].robots for t in r.tasks}
-        observer.wait_for(lambda o: parts <= {(e.robot, e.job) for e in o.events
-                                              if e.kind == TaskEvent.KIND_OPERATION_DONE},
-                          10, "every robot's events")
-        yield launcher, observer
-    finally:
-        launcher.stop()
-        observer.close()
+    with FleetHarness(SCENARIO, out=tmp_path_factory.mktemp('mission')) as fleet:
+        fleet.start_planner()
+        for robot, executable in PAPER_AGENTS.items():
+            fleet.start_agent(robot, executable)
+        executed = fleet.check_mission_complete(timeout=60)
+        yield fleet, executed
 
 
 def test_every_job_is_done_exactly_once(mission):
-    _, observer = mission
+    fleet, _ = mission
+    observer = fleet.observer
     done = [e.job for e in observer.events if e.kind == TaskEvent.KIND_JOB_DONE]
-    problem = load_scenario(SCENARIO)
-    assert sorted(done) == sorted(j.name for j in problem.jobs)
+    assert sorted(done) == sorted(j.name for j in fleet.problem.jobs)
     status = observer.status
     assert (status.jobs_done, status.jobs_total, status.jobs_running) == (12, 12, 0)
     assert status.ignored_stale + status.ignored_duplicate + status.ignored_unknown == 0
@@ -54,10 +40,8 @@ def test_every_job_is_done_exactly_once(mission):
 
 
 def test_executed_timeline_respects_the_problem(mission):
-    _, observer = mission
-    problem = load_scenario(SCENARIO)
-    executed = executed_timeline(problem, observer.plans, observer.events)
-    assert validate(problem, executed) == []
+    fleet, executed = mission
+    observer, problem = fleet.observer, fleet.problem
     plan = observer.plans[-1]
     # Every robot of a job starts it at the same schedule time, and as planned: one robot each.
     for job in executed.jobs:
@@ -79,12 +63,17 @@ def test_executed_timeline_respects_the_problem(mission):
     assert float(executed.makespan) >= plan.makespan - 1e-9
     assert observer.status.projected_makespan == pytest.approx(float(executed.makespan),
                                                                abs=1e-6)
+    # The pinned executables played the paper's types.
+    assert {r: s.robot_type for r, s in observer.robots.items()} == {
+        'Assembler': 'Assembler', 'LSMS': 'LSMS', 'MARC1': 'MARC', 'MARC2': 'MARC'}
 
 
 def test_nodes_exit_cleanly_on_interrupt(mission):
-    launcher, observer = mission
-    assert observer.status.state == MissionStatus.STATE_COMPLETE
-    codes = launcher.stop()
+    fleet, _ = mission
+    assert fleet.observer.status.state == MissionStatus.STATE_COMPLETE
+    codes = fleet.stop()
     assert codes == {name: 0 for name in codes}, codes
+    assert set(codes) == {'planner', 'agent_Assembler', 'agent_LSMS', 'agent_MARC1',
+                          'agent_MARC2'}
     for name in codes:
-        assert 'Traceback' not in launcher.log(name), name
+        assert 'Traceback' not in fleet.log(name), name

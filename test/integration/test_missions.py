@@ -3,29 +3,44 @@ rejected goals, jobs added mid-mission, and a planner killed and restarted mid-m
 
 import time
 from collections import Counter
+from pathlib import Path
 
 import pytest
 import yaml
-from harness import ROBOTS, SCENARIO, executed_timeline
 
 from fjsp_msgs.msg import MissionStatus, RobotState, TaskEvent
 from fjsp_planner.core.scenario import load_scenario
 from fjsp_planner.core.validate import validate
 from fjsp_planner.missions import MissionClient, MissionError
+from fjsp_planner.testing import executed_timeline
+
+SCENARIO = Path(__file__).resolve().parents[2] / 'config' / 'scenarios' / 'solar_panel.yaml'
+ROBOTS = ('Assembler', 'LSMS', 'MARC1', 'MARC2')
 
 SLOW = 0.1
 """Wall seconds per schedule unit: one panel takes about 3 s."""
 
 
 @pytest.fixture
-def fleet(launcher, observer, domain):
+def idle_fleet(fjsp_fleet):
     """An idle planner (no scenario: it waits for goals) and the paper's four agents."""
-    launcher.start_planner(scenario=None, time_scale=SLOW)
-    for robot, _ in ROBOTS:
-        launcher.start_agent(robot)
-    observer.wait_for(lambda o: len(o.robots) == 4, 30, 'the four agents')
-    with MissionClient(domain_id=domain) as client:
+    fleet = fjsp_fleet(SCENARIO, time_scale=SLOW)
+    fleet.start_planner(scenario='')
+    for robot in ROBOTS:
+        fleet.start_agent(robot)
+    fleet.wait_for(lambda o: len(o.robots) == 4, 30, 'the four agents')
+    return fleet
+
+
+@pytest.fixture
+def client(idle_fleet):
+    with MissionClient(domain_id=idle_fleet.domain) as client:
         yield client
+
+
+@pytest.fixture
+def observer(idle_fleet):
+    return idle_fleet.observer
 
 
 def of_mission(observer, mission_id):
@@ -49,19 +64,19 @@ def check_done_once(problem, observer, mission_id):
     assert validate(problem, executed) == []
 
 
-def idle_fleet(observer):
+def fleet_is_idle(observer):
     return all(r.mode == RobotState.MODE_IDLE and not r.current_job
                for r in observer.robots.values())
 
 
-def test_successive_missions_on_one_fleet(fleet, observer):
-    first = fleet.run(SCENARIO, timeout=90)
+def test_successive_missions_on_one_fleet(client, observer):
+    first = client.run(SCENARIO, timeout=90)
     assert first.complete, first
     assert (first.jobs_done, first.jobs_total) == (12, 12)
     assert abs(first.makespan - 32) < 1e-3
     check_done_once(load_scenario(SCENARIO), observer, first.mission_id)
 
-    second = fleet.run(SCENARIO, panels=2, timeout=120)
+    second = client.run(SCENARIO, panels=2, timeout=120)
     assert second.complete, second
     assert second.mission_id != first.mission_id and second.jobs_done == 24
     check_done_once(load_scenario(SCENARIO, panels=2), observer, second.mission_id)
@@ -70,25 +85,25 @@ def test_successive_missions_on_one_fleet(fleet, observer):
     assert plans[0].revision == 1
 
 
-def test_goal_during_a_mission_and_broken_goal_are_rejected(fleet, observer):
-    running = fleet.submit(SCENARIO)
+def test_goal_during_a_mission_and_broken_goal_are_rejected(client, observer):
+    running = client.submit(SCENARIO)
     with pytest.raises(MissionError, match='one mission per fleet') as busy:
-        fleet.submit(SCENARIO)
+        client.submit(SCENARIO)
     assert running.mission_id in str(busy.value)
     broken = {'operation_types': {0: 'weld'}, 'robot_types': {'W': {'weld': 1}},
               'robots': [{'name': 'R1', 'type': 'Welder'}],
               'jobs': [{'name': 'A', 'plans': [['weld']]}, {'name': 'B', 'plans': [['glue']]}],
               'precedence': [['A', 'B'], ['B', 'A']]}
     with pytest.raises(MissionError) as bad:
-        fleet.submit(scenario_yaml=yaml.safe_dump(broken))
+        client.submit(scenario_yaml=yaml.safe_dump(broken))
     text = '\n'.join(bad.value.problems)
     assert "unknown robot type 'Welder'" in text and "'glue'" in text, text
     assert 'precedence cycle' in text, text
     assert running.result(timeout=60).complete  # the running mission was untouched
 
 
-def test_cancel_leaves_the_fleet_idle_for_the_next_mission(fleet, observer):
-    mission = fleet.submit(SCENARIO)
+def test_cancel_leaves_the_fleet_idle_for_the_next_mission(client, observer):
+    mission = client.submit(SCENARIO)
     observer.wait_for(lambda o: o.status is not None
                       and o.status.mission_id == mission.mission_id
                       and o.status.jobs_done >= 2, 30, 'the mission under way')
@@ -96,12 +111,12 @@ def test_cancel_leaves_the_fleet_idle_for_the_next_mission(fleet, observer):
     result = mission.result(timeout=30)
     assert result.state == 'cancelled' and result.jobs_done < 12
     observer.wait_for(lambda o: o.status.state == MissionStatus.STATE_CANCELLED
-                      and idle_fleet(o), 15, 'an idle fleet')
+                      and fleet_is_idle(o), 15, 'an idle fleet')
     _, events = of_mission(observer, mission.mission_id)
     assert any(e.kind == TaskEvent.KIND_ABORTED and e.reason == 'mission cancelled'
                for e in events) or not any(e.kind == TaskEvent.KIND_STARTED
                                            for e in events[-4:])
-    third = fleet.run(SCENARIO, timeout=90)
+    third = client.run(SCENARIO, timeout=90)
     assert third.complete and third.jobs_done == 12
     check_done_once(load_scenario(SCENARIO), observer, third.mission_id)
 
@@ -122,17 +137,17 @@ def second_panel(problem, shift=60) -> str:
         'holding': [[tag(a), tag(b), q] for a, b, q in problem.holding]})
 
 
-def test_a_second_panel_added_mid_mission(fleet, observer):
+def test_a_second_panel_added_mid_mission(client, observer):
     problem = load_scenario(SCENARIO)
-    mission = fleet.submit(SCENARIO)
+    mission = client.submit(SCENARIO)
     observer.wait_for(lambda o: o.status is not None
                       and o.status.mission_id == mission.mission_id
                       and o.status.jobs_done >= 1, 30, 'the first panel under way')
     with pytest.raises(MissionError) as bad:
-        fleet.add_jobs(fragment_yaml=yaml.safe_dump({'jobs': [{'name': 'X', 'plans': [[0]]}],
+        client.add_jobs(fragment_yaml=yaml.safe_dump({'jobs': [{'name': 'X', 'plans': [[0]]}],
                                                      'precedence': [['X', 'Nowhere']]}))
     assert any('Nowhere' in p for p in bad.value.problems), bad.value.problems
-    added = fleet.add_jobs(fragment_yaml=second_panel(problem))
+    added = client.add_jobs(fragment_yaml=second_panel(problem))
     assert len(added) == 12
     result = mission.result(timeout=120)
     assert result.complete and (result.jobs_done, result.jobs_total) == (24, 24), result
@@ -144,28 +159,28 @@ def test_a_second_panel_added_mid_mission(fleet, observer):
     check_done_once(extended, observer, mission.mission_id)
 
 
-def test_planner_killed_mid_mission_resumes_it(launcher, observer, tmp_path):
+def test_planner_killed_mid_mission_resumes_it(fjsp_fleet, tmp_path):
     problem = load_scenario(SCENARIO)
-    journal = tmp_path / 'journal'
-    planner = {'time_scale': 0.15, 'journal_dir': journal}
-    launcher.start_planner(**planner)
-    for robot, _ in ROBOTS:
-        launcher.start_agent(robot)
-    observer.wait_for(lambda o: o.status is not None and o.status.jobs_done >= 3, 40,
-                      'the mission under way')
+    fleet = fjsp_fleet(SCENARIO, time_scale=0.15,
+                       planner={'journal_dir': tmp_path / 'journal'}).start()
+    observer = fleet.observer
+    fleet.wait_for(lambda o: o.status is not None and o.status.jobs_done >= 3, 40,
+                   'the mission under way')
     mission_id = observer.status.mission_id
-    launcher.kill('planner')
+    fleet.kill('planner')
     time.sleep(0.5)
-    launcher.start_planner(**planner)
-    observer.wait_for(lambda o: o.status.state == MissionStatus.STATE_COMPLETE
-                      and o.status.mission_id == mission_id, 90,
-                      'the same mission completed by the restarted planner')
-    assert 'resuming mission' in launcher.log('planner')
+    fleet.start_planner()
+    fleet.wait_for(lambda o: o.status.state == MissionStatus.STATE_COMPLETE
+                   and o.status.mission_id == mission_id, 90,
+                   'the same mission completed by the restarted planner')
+    assert 'resuming mission' in fleet.log('planner')
     check_done_once(problem, observer, mission_id)
     # Restarted once more after the end: it does not run the mission again.
-    launcher.stop('planner')
-    launcher.start_planner(**planner)
-    time.sleep(3)
-    assert 'not starting' in launcher.log('planner')
-    plans, _ = of_mission(observer, mission_id)
-    assert len({p.mission_id for p in observer.plans}) == 1
+    fleet.stop('planner')
+    fleet.start_planner()
+    deadline = time.monotonic() + 30
+    while 'not starting' not in fleet.log('planner') and time.monotonic() < deadline:
+        time.sleep(0.2)
+    assert 'not starting' in fleet.log('planner')
+    time.sleep(1)
+    assert {p.mission_id for p in observer.plans} == {mission_id}

@@ -2,18 +2,23 @@
 have, shows on mission_status with a reason naming the robot, and the mission goes on
 without it where it can."""
 
-from harness import ROBOTS
+from pathlib import Path
 
 from fjsp_msgs.msg import MissionStatus
 
+SCENARIO = Path(__file__).resolve().parents[2] / 'config' / 'scenarios' / 'solar_panel.yaml'
+ROBOTS = ('Assembler', 'LSMS', 'MARC1', 'MARC2')
 
-def test_type_mismatch_and_unknown_agent_reach_mission_status(launcher, observer):
-    launcher.start_planner(time_scale=0.1)
-    for robot, executable in ROBOTS:
+
+def test_type_mismatch_and_unknown_agent_reach_mission_status(fjsp_fleet):
+    fleet = fjsp_fleet(SCENARIO, time_scale=0.1)
+    observer = fleet.observer
+    fleet.start_planner()
+    for robot in ROBOTS:
         # MARC1 is started as an LSMS: it must refuse a plan that makes it a MARC.
-        launcher.start_agent(robot, 'lsms_agent' if robot == 'MARC1' else executable)
-    launcher.start_agent('R2D2', 'robot_agent')
-    observer.wait_for(lambda o: o.status is not None and any(
+        fleet.start_agent(robot, 'lsms_agent' if robot == 'MARC1' else 'robot_agent')
+    fleet.start_agent('R2D2')
+    fleet.wait_for(lambda o: o.status is not None and any(
         "robot 'MARC1' refuses its plan" in w for w in o.status.warnings)
         and any("'R2D2'" in w for w in o.status.warnings), 30,
         'warnings naming the refusing MARC1 and the unknown R2D2')
@@ -21,7 +26,7 @@ def test_type_mismatch_and_unknown_agent_reach_mission_status(launcher, observer
     assert "makes 'MARC1' a 'MARC' but this agent plays a 'LSMS'" in warnings
     assert "scenario 'solar_panel' has no such robot" in warnings
     # The plan in force leaves the refusing robot out, and the others complete the mission.
-    observer.wait_for(lambda o: o.complete(), 60, 'the mission to complete without MARC1')
+    fleet.wait_for(lambda o: o.complete(), 60, 'the mission to complete without MARC1')
     last = observer.plans[-1]
     assert not next(r for r in last.robots if r.robot == 'MARC1').tasks
     assert observer.status.state == MissionStatus.STATE_COMPLETE

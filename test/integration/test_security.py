@@ -5,9 +5,9 @@ planned. Signing itself is checked first, without processes."""
 import copy
 import math
 import time
+from pathlib import Path
 
 import pytest
-from harness import ROBOTS
 
 from fjsp_common.auth import PLANNER, FleetKeyError, Signer, Verifier, new_key, read_key
 from fjsp_common.contract import (
@@ -19,6 +19,9 @@ from fjsp_common.contract import (
 )
 from fjsp_msgs.msg import MissionStatus, Plan, RobotState, TaskEvent
 from fjsp_planner.faults import FaultError, inject_fault
+
+SCENARIO = Path(__file__).resolve().parents[2] / 'config' / 'scenarios' / 'solar_panel.yaml'
+ROBOTS = ('Assembler', 'LSMS', 'MARC1', 'MARC2')
 
 
 @pytest.fixture
@@ -77,20 +80,21 @@ def test_new_keys_are_private_and_distinct(tmp_path):
 
 # --- a fleet under attack -------------------------------------------------------------------
 
-def start_fleet(launcher, observer, key_file, **planner):
-    launcher.start_planner(time_scale=0.15, fleet_key_file=key_file, **planner)
-    for robot, _ in ROBOTS:
-        launcher.start_agent(robot, fleet_key_file=key_file)
-    observer.wait_for(lambda o: o.status is not None and o.status.jobs_done >= 1, 40,
-                      'the mission under way')
+def start_fleet(fjsp_fleet, key_file, **planner):
+    fleet = fjsp_fleet(SCENARIO, time_scale=0.15,
+                       planner={'fleet_key_file': key_file, **planner},
+                       agents={'fleet_key_file': key_file}).start()
+    fleet.wait_for(lambda o: o.status is not None and o.status.jobs_done >= 1, 40,
+                   'the mission under way')
+    return fleet, fleet.observer
 
 
-def test_forged_plan_event_and_state_are_dropped(launcher, observer, key_file, tmp_path):
-    start_fleet(launcher, observer, key_file)
-    plans = observer.publisher(Plan, PLAN_TOPIC, LATCHED_QOS)
-    events = observer.publisher(TaskEvent, TASK_EVENTS_TOPIC, EVENTS_QOS)
-    states = observer.publisher(RobotState, ROBOT_STATES_TOPIC, LATCHED_QOS)
-    observer.wait_for(lambda o: plans.get_subscription_count() >= 6
+def test_forged_plan_event_and_state_are_dropped(fjsp_fleet, key_file, tmp_path):
+    fleet, observer = start_fleet(fjsp_fleet, key_file)
+    plans = observer.node.create_publisher(Plan, PLAN_TOPIC, LATCHED_QOS)
+    events = observer.node.create_publisher(TaskEvent, TASK_EVENTS_TOPIC, EVENTS_QOS)
+    states = observer.node.create_publisher(RobotState, ROBOT_STATES_TOPIC, LATCHED_QOS)
+    fleet.wait_for(lambda o: plans.get_subscription_count() >= 6
                       and events.get_subscription_count() >= 6
                       and states.get_subscription_count() >= 2, 15,
                       'the nodes to discover the forger')
@@ -109,21 +113,21 @@ def test_forged_plan_event_and_state_are_dropped(launcher, observer, key_file, t
         states.publish(RobotState(robot='MARC1', mission_id=mission, mode=RobotState.MODE_FAILED,
                                   busy_until=math.nan))
         time.sleep(0.1)
-    observer.wait_for(lambda o: o.complete(), 60, 'the mission to complete as planned')
+    fleet.wait_for(lambda o: o.complete(), 60, 'the mission to complete as planned')
     status = observer.status
     assert status.plan_revision == 1, 'a forged message caused a re-plan'
     assert status.jobs_done == status.jobs_total == 12
     assert status.ignored_unauthenticated >= 4
-    for robot, _ in ROBOTS:
+    for robot in ROBOTS:
         assert observer.robots[robot].plan_revision == 1
-        assert 'dropping an unauthenticated message' in launcher.log(f'{robot.lower()}_agent')
+        assert 'dropping an unauthenticated message' in fleet.log(f'agent_{robot}')
     started = {e.job for e in observer.events if e.kind == TaskEvent.KIND_STARTED}
     assert remaining in started, 'the forged job-done made the robots skip a job'
     assert observer.status.state == MissionStatus.STATE_COMPLETE
 
 
-def test_fault_requests_need_the_key(launcher, observer, key_file, tmp_path):
-    start_fleet(launcher, observer, key_file, start_delay=3.0)
+def test_fault_requests_need_the_key(fjsp_fleet, key_file, tmp_path):
+    fleet, observer = start_fleet(fjsp_fleet, key_file, start_delay=3.0)
     with pytest.raises(FaultError, match='not signed with the fleet key'):
         inject_fault('LSMS', 'delay', 1.5, node=observer.node)
     other = new_key(tmp_path / 'other.key')

@@ -71,6 +71,9 @@ def shorten(text: str, limit: int = 200) -> str:
     return text if len(text) <= limit else f'{text[:limit]}... ({len(text)} characters)'
 
 
+STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+
 def run_node(make_node: Callable[[], Node], logger: str, args=None,
              spin: Callable[[Node], None] = rclpy.spin) -> int:
     """Build the node, spin it until shutdown, clean up; the process's exit code.
@@ -80,7 +83,8 @@ def run_node(make_node: Callable[[], Node], logger: str, args=None,
     comes stops too.
     """
     rclpy.init(args=args, signal_handler_options=rclpy.signals.SignalHandlerOptions.NO)
-    previous = {sig: signal.signal(sig, _interrupt) for sig in (signal.SIGINT, signal.SIGTERM)}
+    for sig in STOP_SIGNALS:
+        signal.signal(sig, _interrupt)
     node = None
     code = 0
     try:
@@ -92,8 +96,10 @@ def run_node(make_node: Callable[[], Node], logger: str, args=None,
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
+        # A second Ctrl-C (or the launcher's SIGINT after a terminal's) must not break the
+        # clean-up into a traceback.
+        for sig in STOP_SIGNALS:
+            signal.signal(sig, signal.SIG_IGN)
         if node is not None:
             try:
                 node.destroy_node()

@@ -19,10 +19,10 @@ when a call is made, so arguments can be checked without a built workspace.
 """
 
 import argparse
+import itertools
 import math
 import os
 import sys
-import threading
 import time
 import uuid
 from contextlib import contextmanager
@@ -69,22 +69,30 @@ def inject_fault(robot: str, fault: str, factor: float | None = None, *, node=No
     """Inject `fault` ('fail', 'recover' or 'delay' with `factor`) into `robot`'s agent.
 
     Returns the agent's message. Waits up to `timeout` seconds for the agent's service to
-    appear and as long again for its answer. With `node` (an rclpy node), calls through it:
-    it is spun here unless an executor already spins it, so call from outside that
-    executor's callbacks. Without, uses a private node in a private context, so it works
-    whether or not the caller has called `rclpy.init`, and never touches the caller's
-    context. Both honour ROS_DOMAIN_ID and the other ROS environment variables. A new
-    node (hence every private one) first waits for DDS discovery, up to about 3 s with
-    Fast DDS on localhost; a node that has been running a while gets its answer in
-    milliseconds, so pass one when the fault must land at a precise moment. In a fleet with
-    a key, the request is signed with the key in `key_file` (default: the file named by
+    appear and as long again for its answer. The call is made by a short-lived node of its
+    own, spun here by an executor of its own:
+
+    - without `node`, in a private rclpy context, so it works whether or not the caller has
+      called `rclpy.init`, and never touches the caller's context. Its process joins the
+      DDS domain afresh and first waits for discovery, up to about 3 s with Fast DDS on
+      localhost;
+    - with `node` (any rclpy node that has been running a while), in that node's context
+      and namespace: the context has discovered the fleet already, so the answer comes in
+      milliseconds; pass one when the fault must land at a precise moment. `node` itself is
+      neither spun nor added to an executor, so this works however the caller spins it (an
+      executor on another thread, by hand in this thread, not at all) and even from inside
+      one of its callbacks.
+
+    Both honour ROS_DOMAIN_ID and the other ROS environment variables. In a fleet with a
+    key, the request is signed with the key in `key_file` (default: the file named by
     $FJSP_FLEET_KEY_FILE).
     """
     factor = check_fault(fault, factor)
     if not (isinstance(timeout, int | float) and math.isfinite(timeout) and timeout > 0):
         raise FaultError(f'timeout must be a number of seconds > 0, got {timeout!r}')
     if node is not None:
-        return _call(node, robot, fault, factor, timeout, key_file)
+        with _helper_node(node.context, node.get_namespace()) as helper:
+            return _call(helper, robot, fault, factor, timeout, key_file)
     with _own_node(args=[]) as own:
         return _call(own, robot, fault, factor, timeout, key_file)
 
@@ -107,6 +115,26 @@ def _own_node(args):
             node.destroy_node()
     finally:
         rclpy.try_shutdown(context=context)
+
+
+_helpers = itertools.count()
+
+
+@contextmanager
+def _helper_node(context, namespace=None):
+    """A node of this call only. Borrowing the caller's node instead would mean spinning it:
+    adding it to an executor of ours takes it away from the caller's executor (rclpy keeps
+    one executor per node), and waiting for the caller's executor to take the answer hangs
+    until the timeout when that executor is not spinning at the moment."""
+    import rclpy
+
+    node = rclpy.create_node(f'inject_fault_{os.getpid()}_{next(_helpers)}', context=context,
+                             namespace=namespace, enable_rosout=False,
+                             start_parameter_services=False)
+    try:
+        yield node
+    finally:
+        node.destroy_node()
 
 
 def _call(node, robot, fault, factor, timeout, key_file) -> str:
@@ -161,22 +189,15 @@ def _answer(node, client, request, signer, name, timeout):
 
 
 def _wait(node, future, timeout) -> bool:
-    """Wait for the answer: spin `node` here unless an executor already does."""
-    if node.executor is None:
-        from rclpy.executors import SingleThreadedExecutor
+    """Spin our own `node` until the answer comes or `timeout` passes; whether it came."""
+    from rclpy.executors import SingleThreadedExecutor
 
-        executor = SingleThreadedExecutor(context=node.context)
-        try:
-            executor.add_node(node)
-            executor.spin_until_future_complete(future, timeout_sec=timeout)
-        finally:
-            executor.remove_node(node)
-            node.executor = None  # remove_node leaves the node pointing at this executor
-            executor.shutdown()
-    else:
-        answered = threading.Event()
-        future.add_done_callback(lambda _: answered.set())
-        answered.wait(timeout)
+    executor = SingleThreadedExecutor(context=node.context)
+    try:
+        executor.add_node(node)
+        executor.spin_until_future_complete(future, timeout_sec=timeout)
+    finally:
+        executor.shutdown()
     return future.done()
 
 

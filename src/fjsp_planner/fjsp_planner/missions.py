@@ -193,7 +193,6 @@ class MissionClient:
                                shift=shift, time_limit=time_limit,
                                replan_time_limit=replan_time_limit, time_scale=time_scale,
                                blocked_timeout=blocked_timeout)
-        self._signer.sign(goal, self._node.resolve_topic_name(self._action_name))
         if not self._action.wait_for_server(timeout_sec=timeout):
             raise MissionError(f"no planner serves '{self._action_name}' (waited "
                                f'{timeout:g} s): is the planner running, with the same '
@@ -208,9 +207,17 @@ class MissionClient:
             if feedback is not None:
                 feedback(msg.feedback)
 
-        accepted = self._action.send_goal_async(goal, feedback_callback=on_feedback)
-        if not self._wait(accepted, timeout):
-            raise MissionError(f'the planner did not answer the goal within {timeout:g} s')
+        # A fresh client's first answer can be lost: the goal is resent, with the same
+        # request id, until one is answered; the planner hands the mission to the latest.
+        goal.request_id = f'{self._node.get_name()}/{uuid.uuid4().hex}'
+        deadline = time.monotonic() + timeout
+        while True:
+            self._signer.sign(goal, self._node.resolve_topic_name(self._action_name))
+            accepted = self._action.send_goal_async(goal, feedback_callback=on_feedback)
+            if self._wait(accepted, min(RESEND, max(deadline - time.monotonic(), 0.0))):
+                break
+            if time.monotonic() >= deadline:
+                raise MissionError(f'the planner did not answer the goal within {timeout:g} s')
         goal_handle = accepted.result()
         if not goal_handle.accepted:
             raise MissionError('the planner refused the goal')

@@ -469,7 +469,14 @@ class RobotExecution:
         task = self.tasks[self._index]
         self._attempts[task.job] = self._attempts.get(task.job, 0) + 1
         departure = max(self._free_at, self._not_before)
-        leg = 0.0 if self._holding or not self.location else max(task.leg, 0.0)
+        if self.location:
+            leg = 0.0 if self._holding else max(task.leg, 0.0)
+        else:
+            # Not placed yet: it leaves from where the plan starts it (the scenario's start
+            # location; a robot that may start anywhere has no first leg), and not before the
+            # plan has it leave (its release time, or the job's start for such a robot).
+            leg = max(task.leg, 0.0)
+            departure = max(departure, task.travel_start)
         self._phase = _Phase.TRAVEL
         self._phase_start = departure
         self._phase_end = later(departure + leg) if leg > 0 else departure

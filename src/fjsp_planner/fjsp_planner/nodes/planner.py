@@ -101,11 +101,13 @@ def origin_of(text: str, panels: int, shift: float) -> str:
 
 
 class Goal:
-    """A RunMission goal whose mission runs: answered when the mission ends."""
+    """A RunMission goal whose mission runs: answered when the mission ends, or when a resent
+    goal takes the mission over (`ended` then holds None)."""
 
     def __init__(self, handle, mission_id: str):
         self.handle = handle
         self.mission_id = mission_id
+        self.request_id = handle.request.request_id
         self.ended = RosFuture()
 
 
@@ -303,6 +305,9 @@ class PlannerNode(Node):
         goal = handle.request
         if not self.auth.accept(goal, RUN_MISSION_ACTION):
             return self.reject(handle, ['the goal is not signed with the fleet key'])
+        if goal.request_id and self.goal is not None \
+                and goal.request_id == self.goal.request_id:
+            return await self.take_over(handle)
         try:
             problem, text, name = self.problem_of(goal)
         except ProblemError as error:
@@ -322,7 +327,22 @@ class PlannerNode(Node):
         self.goal = Goal(handle, mission_id)
         self.publish_feedback()
         state = await self.goal.ended
-        return self.finish_goal(state)
+        return self.finish_goal(state) if state is not None else self.superseded(handle)
+
+    async def take_over(self, handle):
+        """A goal resent by a client that did not hear the first one accepted: it follows
+        the mission the first one started, which answers no more."""
+        superseded, self.goal = self.goal, Goal(handle, self.goal.mission_id)
+        superseded.ended.set_result(None)
+        self.publish_feedback()
+        state = await self.goal.ended
+        return self.finish_goal(state) if state is not None else self.superseded(handle)
+
+    def superseded(self, handle) -> RunMission.Result:
+        handle.abort()
+        return RunMission.Result(state=RunMission.Result.STATE_REJECTED, makespan=math.nan,
+                                 planned_makespan=math.nan,
+                                 reasons=['superseded: the same request was sent again'])
 
     def problem_of(self, goal):
         """The goal's scenario: (problem, YAML text, name); ProblemError if it has problems."""

@@ -1,0 +1,595 @@
+"""The fleet launcher: the planner, one generic robot agent per robot a scenario lists, and the
+monitor, each in a process of its own, from start-up to the end of the mission.
+
+`launch` and `launch_ros` are not published on PyPI, so this is the project's one launcher,
+used alike by `ros2 run fjsp_planner fleet`, `ros2_ws/demo.sh`, the test harness
+(`fjsp_planner.testing`) and the benchmarks. It finds executables through the ament index as
+`ros2 run` does, so it works with this workspace and with a ROS 2 install alike.
+
+No node may outlive the launcher: each runs in a process group of its own (a Ctrl-C in the
+terminal reaches the launcher only, which then interrupts each node and kills what does not
+stop), and the kernel kills it if the launcher dies (PR_SET_PDEATHSIG), even of a SIGKILL.
+
+The launcher judges the mission from `mission_status` through a subscription of its own,
+not from the monitor's exit: the monitor is a view, and a view may be left out.
+"""
+
+import argparse
+import ctypes
+import itertools
+import math
+import os
+import re
+import signal
+import subprocess
+import sys
+import threading
+import time
+from contextlib import contextmanager
+from pathlib import Path
+
+import rclpy
+import yaml
+from ament_index_python.packages import get_package_prefix
+from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+
+from fjsp_common.contract import LATCHED_QOS, MISSION_STATUS_TOPIC
+from fjsp_msgs.msg import MissionStatus
+from fjsp_planner.core.problem import Problem, ProblemError
+from fjsp_planner.core.scenario import load_scenario
+from fjsp_planner.workspace import default_out_dir, installed_scenarios
+from robot_agents.agent_node import agent_node_name
+
+PLANNER_NODE = 'planner'
+MONITOR_NODE = 'monitor'
+MONITOR_OUT_PARAMETER = 'gantt_dir'
+"""The monitor's parameter naming the directory its outputs go to."""
+DEFAULT_SCENARIO = 'solar_panel.yaml'
+DEFAULT_TIME_SCALE = 0.2
+"""Wall seconds per schedule unit: the paper's 32-unit mission takes about 6 s."""
+STOP_GRACE = 5.0
+"""Seconds a node has to stop after SIGINT before it is killed."""
+MONITOR_FINISH = 30.0
+"""Seconds the monitor may take, once the mission is complete, to write its summary."""
+
+EXIT_FAILED = 1
+EXIT_BAD_INPUT = 2
+ROS_NAME = re.compile(r'[A-Za-z][A-Za-z0-9_]*')
+"""A robot name usable in node and service names: `agent_<robot>`, `<robot>/inject_fault`."""
+
+_PR_SET_PDEATHSIG = 1
+
+
+class FleetError(ValueError):
+    """A fleet that cannot be started; `problems` lists every reason, each naming the item."""
+
+    def __init__(self, problems):
+        self.problems = list(problems)
+        super().__init__('\n'.join(self.problems))
+
+
+def resolve_scenario(scenario=None) -> Path:
+    """The scenario file to run: a path, or the name of a scenario installed with the package
+    (`truss`, `truss.yaml`); by default the paper's `solar_panel.yaml`."""
+    path = Path(scenario if scenario is not None else DEFAULT_SCENARIO).expanduser()
+    if path.is_file() or path.parent != Path('.'):
+        return path.resolve()
+    installed = installed_scenarios()
+    for name in (path.name, f'{path.name}.yaml'):
+        if installed is not None and (installed / name).is_file():
+            return installed / name
+    return path.resolve()
+
+
+def robot_name_problems(problem: Problem) -> list[str]:
+    return [f"robot '{r.name}': its name must be usable in ROS names (ASCII letters, digits "
+            'and underscores, starting with a letter)'
+            for r in problem.robots if not ROS_NAME.fullmatch(r.name)]
+
+
+def find_executable(package: str, executable: str) -> Path:
+    """`<prefix>/lib/<package>/<executable>`, as `ros2 run` finds it."""
+    try:
+        prefix = get_package_prefix(package)
+    except (LookupError, OSError, ValueError):
+        raise FleetError([f"package '{package}' not found: is the workspace sourced "
+                          '(source ros2_ws/env.sh)?']) from None
+    path = Path(prefix) / 'lib' / package / executable
+    if not (path.is_file() and os.access(path, os.X_OK)):
+        raise FleetError([f"package '{package}' has no executable '{executable}'"])
+    return path
+
+
+def read_params_file(path: Path) -> tuple[dict, list[str]]:
+    """The parameters file's sections, and what makes it unusable (empty if nothing)."""
+    try:
+        data = yaml.safe_load(path.read_text())
+    except OSError as error:
+        return {}, [f'{path}: cannot read parameters file: {error.strerror}']
+    except yaml.YAMLError as error:
+        mark = getattr(error, 'problem_mark', None)
+        where = f'line {mark.line + 1}, column {mark.column + 1}' if mark else 'unknown place'
+        return {}, [f'{path}: YAML syntax error at {where}: '
+                    f"{getattr(error, 'problem', None) or error}"]
+    if not isinstance(data, dict) or not list(_sections(data)):
+        return {}, [f'{path}: not a ROS parameters file (expected sections like '
+                    "'/**: {ros__parameters: {...}}' or '<node name>: {ros__parameters: ...}')"]
+    return data, []
+
+
+def _sections(data: dict, namespace=()):
+    """(node name pattern tokens, parameters) of each `ros__parameters` section."""
+    for key, value in data.items():
+        if key == 'ros__parameters' and isinstance(value, dict):
+            yield namespace, value
+        elif isinstance(value, dict):
+            yield from _sections(value, namespace + tuple(t for t in str(key).split('/') if t))
+
+
+def sets_parameter(params: dict, node: str, name: str) -> bool:
+    """Whether a parameters file (as read) gives node `/<node>` a value for `name`; `*` and
+    `**` match one and any number of name tokens, as rcl matches them."""
+    for tokens, values in _sections(params):
+        pattern = ''.join('(?:/[^/]+)*' if t == '**' else '/[^/]+' if t == '*'
+                          else '/' + re.escape(t) for t in tokens)
+        if name in values and re.fullmatch(pattern, f'/{node}'):
+            return True
+    return False
+
+
+def ros_string(text: str) -> str:
+    """`text` as a `-p name:=value` value: rcl reads values as YAML, so it is quoted (a robot
+    named `on` or `1e3` stays a string)."""
+    return "'" + text.replace("'", "''") + "'"
+
+
+def write_node_params(path: Path, node: str, params: dict) -> None:
+    """A parameters file giving `params` to node `/<node>` alone. Passed after the user's
+    file, it wins over it: rclpy applies a node's own section after the `/**` one, and of two
+    files the later one (`-p` values count as `/**`, so they would lose to a user's
+    node section)."""
+    values = {k: str(v) if isinstance(v, Path) else v for k, v in params.items()}
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(yaml.safe_dump({f'/{node}': {'ros__parameters': values}},
+                                   sort_keys=False))
+
+
+def _prepare_node(parent: int):
+    """What the child runs between fork and exec.
+
+    The kernel kills it when the launcher dies. SIGINT is ignored until the node installs
+    its own handler (every node does first thing; a Python process does not install its
+    default one over an ignored SIGINT): a Ctrl-C that catches a node still importing its
+    modules would otherwise end it with a traceback; ignored, the node is killed after the
+    grace period instead."""
+    prctl = ctypes.CDLL(None, use_errno=True).prctl
+
+    def prepare():
+        prctl(_PR_SET_PDEATHSIG, signal.SIGKILL)
+        if os.getppid() != parent:  # the launcher died before the request took effect
+            os._exit(1)
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+    return prepare
+
+
+class Fleet:
+    """The processes of one fleet: the planner, one `robot_agent` per robot of the scenario,
+    the monitor, and any node a test adds.
+
+    Every node gets `params_file` (if given), then the launcher's own parameters, which win
+    over it: the scenario, and the time scale and output directory unless the file sets them
+    and they were not given here. `planner`, `agents` and `monitor` add parameters of those
+    nodes. Logs go to `<out>/logs/<node>.log`.
+
+    Start nodes from a thread that lives as long as the fleet (the main thread): the kernel
+    sends the parent-death signal when the thread that started a node ends.
+    """
+
+    def __init__(self, scenario=None, *, panels: int | None = None,
+                 time_scale: float | None = None, params_file=None, out=None,
+                 domain: int | None = None, env: dict | None = None,
+                 planner: dict | None = None, agents: dict | None = None,
+                 monitor: dict | None = None):
+        problems = []
+        self.scenario = resolve_scenario(scenario)
+        self.problem: Problem | None = None
+        if not self.scenario.is_file():
+            known = installed_scenarios()
+            names = sorted(p.name for p in known.glob('*.yaml')) if known else []
+            problems.append(f'{scenario}: no such scenario file'
+                            + (f' (installed: {", ".join(names)})' if names else ''))
+        else:
+            try:
+                self.problem = load_scenario(self.scenario, panels=panels)
+            except ProblemError as error:
+                problems += error.problems
+            else:
+                problems += [f'{self.scenario}: {p}' for p in robot_name_problems(self.problem)]
+        self.params_file = Path(params_file).resolve() if params_file is not None else None
+        self.params = {}
+        if self.params_file is not None:
+            self.params, unusable = read_params_file(self.params_file)
+            problems += unusable
+        for package, executable in (('fjsp_planner', 'planner_node'),
+                                    ('fjsp_planner', 'monitor_node'),
+                                    ('robot_agents', 'robot_agent')):
+            try:
+                find_executable(package, executable)
+            except FleetError as error:
+                problems += error.problems
+        if problems:
+            raise FleetError(problems)
+
+        self.panels = panels
+        self.time_scale = time_scale
+        self.out_given = out is not None
+        self.out = Path(out).expanduser().resolve() if out is not None else default_out_dir()
+        self.logs = self.out / 'logs'
+        self.env = dict(os.environ, PYTHONUNBUFFERED='1', **(env or {}))
+        if domain is not None:
+            self.env['ROS_DOMAIN_ID'] = str(domain)
+        self.domain = domain
+        self.extra = {PLANNER_NODE: dict(planner or {}), 'agents': dict(agents or {}),
+                      MONITOR_NODE: dict(monitor or {})}
+        self.processes: dict[str, subprocess.Popen] = {}
+        self._streams: list[threading.Thread] = []
+
+    # --- starting --------------------------------------------------------------------
+
+    def start(self, *, monitor: bool = True, stream_monitor: bool = False) -> 'Fleet':
+        """The planner, an agent for every robot of the scenario, and the monitor."""
+        self.start_planner()
+        for robot in self.problem.robots:
+            self.start_agent(robot.name)
+        if monitor:
+            self.start_monitor(stream=stream_monitor)
+        return self
+
+    def start_planner(self, **params) -> subprocess.Popen:
+        own = {'scenario': self.scenario}
+        if self.panels is not None:
+            own['panels'] = self.panels
+        if self.time_scale is not None or not self._file_sets(PLANNER_NODE, 'time_scale'):
+            own['time_scale'] = self.time_scale or DEFAULT_TIME_SCALE
+        return self.start_node(PLANNER_NODE, 'fjsp_planner', 'planner_node',
+                               {**own, **self.extra[PLANNER_NODE], **params})
+
+    def start_agent(self, robot: str, executable: str = 'robot_agent',
+                    **params) -> subprocess.Popen:
+        """The agent of `robot` (`robot_agent`, or a type-pinning alias such as
+        `marc_agent`); it need not be a robot of the scenario."""
+        # The agent reads robot_name before its node, named after it, exists: a `-p`
+        # value (for every node of the process) reaches it there.
+        return self.start_node(agent_node_name(robot), 'robot_agents', executable,
+                               {**self.extra['agents'], **params},
+                               ros_args=('-p', f'robot_name:={ros_string(robot)}'))
+
+    def start_monitor(self, stream: bool = False, **params) -> subprocess.Popen:
+        """The monitor; with `stream`, its output goes to this process's stdout too."""
+        own = {}
+        if self.out_given or not self._file_sets(MONITOR_NODE, MONITOR_OUT_PARAMETER):
+            own[MONITOR_OUT_PARAMETER] = self.out
+        return self.start_node(MONITOR_NODE, 'fjsp_planner', 'monitor_node',
+                               {**own, **self.extra[MONITOR_NODE], **params}, stream=stream)
+
+    def start_node(self, name: str, package: str, executable: str, params=None,
+                   ros_args=(), stream: bool = False) -> subprocess.Popen:
+        """Start `executable` of `package` as node `name` with `params` (written to
+        `<out>/params/<name>.yaml`, after the user's parameters file) and any further ROS
+        arguments; its log: `<out>/logs/<name>.log` (a node started again appends to it)."""
+        previous = self.processes.get(name)
+        if previous is not None and previous.poll() is None:
+            raise FleetError([f"node '{name}' is already running (pid {previous.pid})"])
+        command = [str(find_executable(package, executable)), '--ros-args']
+        if self.params_file is not None:
+            command += ['--params-file', str(self.params_file)]
+        if params:
+            own = self.out / 'params' / f'{name}.yaml'
+            write_node_params(own, name, params)
+            command += ['--params-file', str(own)]
+        command += list(ros_args)
+        self.logs.mkdir(parents=True, exist_ok=True)
+        log = (self.logs / f'{name}.log').open('a' if previous else 'w')
+        try:
+            process = subprocess.Popen(
+                command, env=self.env, stdin=subprocess.DEVNULL,
+                stdout=subprocess.PIPE if stream else log, stderr=subprocess.STDOUT,
+                start_new_session=True, preexec_fn=_prepare_node(os.getpid()))
+        finally:
+            if not stream:
+                log.close()
+        if stream:
+            copier = threading.Thread(target=_copy_lines, args=(process.stdout, log),
+                                      name=f'{name}_output', daemon=True)
+            copier.start()
+            self._streams.append(copier)
+        self.processes[name] = process
+        return process
+
+    def _file_sets(self, node: str, parameter: str) -> bool:
+        return sets_parameter(self.params, node, parameter)
+
+    # --- watching and stopping -------------------------------------------------------
+
+    def log(self, name: str) -> str:
+        return (self.logs / f'{name}.log').read_text()
+
+    def exited(self) -> dict[str, int]:
+        """Exit codes of the nodes that have ended (negative: killed by that signal)."""
+        return {name: p.returncode for name, p in self.processes.items()
+                if p.poll() is not None}
+
+    def kill(self, name: str) -> int:
+        """SIGKILL node `name`, as a crash would: it gets no chance to say goodbye."""
+        process = self.processes[name]
+        if process.poll() is None:
+            os.killpg(process.pid, signal.SIGKILL)
+        return process.wait(timeout=STOP_GRACE)
+
+    def stop(self, name: str | None = None, timeout: float = STOP_GRACE) -> dict[str, int]:
+        """SIGINT each node's process group (all nodes, or `name`), SIGKILL what is still
+        running after `timeout` seconds; the exit codes."""
+        names = [name] if name else list(self.processes)
+        for n in names:
+            if self.processes[n].poll() is None:
+                os.killpg(self.processes[n].pid, signal.SIGINT)
+        deadline = time.monotonic() + timeout
+        codes = {}
+        for n in names:
+            process = self.processes[n]
+            try:
+                codes[n] = process.wait(timeout=max(0.1, deadline - time.monotonic()))
+            except subprocess.TimeoutExpired:
+                os.killpg(process.pid, signal.SIGKILL)
+                codes[n] = process.wait()
+        for copier in self._streams:
+            copier.join(timeout=1.0)
+        return codes
+
+    def __enter__(self) -> 'Fleet':
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.stop()
+
+
+def _copy_lines(source, log) -> None:
+    """The streamed node's output to the log and to stdout, line by line, until it ends."""
+    with source, log:
+        for line in iter(source.readline, b''):
+            log.write(line.decode(errors='replace'))
+            log.flush()
+            sys.stdout.buffer.write(line)
+            sys.stdout.flush()
+
+
+class Listener:
+    """A node in a private rclpy context on one domain, spun on a thread of its own: its owner
+    (the launcher, a test) keeps its main thread, and the default context a user's code may
+    use is never touched. Callbacks added with `subscribe` run under `lock`, which
+    `wait_for` waits on."""
+
+    _numbers = itertools.count()
+
+    def __init__(self, domain: int | None = None, name: str = 'fleet_listener',
+                 discovery_range: str | None = None):
+        self.context = rclpy.Context()
+        with _environment(ROS_AUTOMATIC_DISCOVERY_RANGE=discovery_range):
+            rclpy.init(context=self.context, domain_id=domain)
+        try:
+            self.node = rclpy.create_node(f'{name}_{os.getpid()}_{next(self._numbers)}',
+                                          context=self.context, enable_rosout=False,
+                                          start_parameter_services=False)
+        except BaseException:
+            rclpy.try_shutdown(context=self.context)
+            raise
+        self.lock = threading.Condition()
+        self.executor = SingleThreadedExecutor(context=self.context)
+        self.executor.add_node(self.node)
+        self.thread = threading.Thread(target=self._spin, name=name, daemon=True)
+        self.thread.start()
+
+    def _spin(self) -> None:
+        try:
+            while self.context.ok():
+                self.executor.spin_once(timeout_sec=0.1)
+        except ExternalShutdownException:
+            pass
+        except Exception:  # noqa: BLE001  the context went down between the check and the spin
+            if self.context.ok():
+                raise
+
+    def subscribe(self, msg_type, topic: str, qos, callback):
+        def locked(msg):
+            with self.lock:
+                callback(msg)
+                self.lock.notify_all()
+        return self.node.create_subscription(msg_type, topic, locked, qos)
+
+    def wait_for(self, predicate, timeout: float) -> bool:
+        """Wait until `predicate()` holds (checked under the lock at every message); whether
+        it does."""
+        with self.lock:
+            return self.lock.wait_for(predicate, timeout=timeout)
+
+    def close(self) -> None:
+        self.executor.shutdown(timeout_sec=1.0)
+        self.node.destroy_node()
+        rclpy.try_shutdown(context=self.context)
+        self.thread.join(timeout=2.0)
+
+
+@contextmanager
+def _environment(**values):
+    """Set environment variables (None: leave as is) for the duration of a `with` block."""
+    values = {k: v for k, v in values.items() if v is not None}
+    saved = {k: os.environ.get(k) for k in values}
+    os.environ.update(values)
+    try:
+        yield
+    finally:
+        for key, value in saved.items():
+            if value is None:
+                os.environ.pop(key, None)
+            else:
+                os.environ[key] = value
+
+
+# --- the command line ----------------------------------------------------------------
+
+class _SignalError(Exception):
+    """SIGINT or SIGTERM reached the launcher."""
+
+    def __init__(self, signum):
+        super().__init__(signal.Signals(signum).name)
+        self.code = 128 + signum
+
+
+def _stop_signal(signum, frame):
+    raise _SignalError(signum)
+
+
+def _positive(kind):
+    def parse(text):
+        try:
+            value = kind(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f'expected a number > 0, got {text!r}') from None
+        if not (math.isfinite(value) and value > 0):
+            raise argparse.ArgumentTypeError(f'must be > 0, got {text}')
+        return value
+    return parse
+
+
+def parse_arguments(argv) -> argparse.Namespace:
+    parser = argparse.ArgumentParser(
+        prog='fleet',
+        description='Run a scenario on the node network: the planner, one robot_agent per '
+                    'robot of the scenario and the monitor, until Ctrl-C (or the end of the '
+                    'mission with --exit-on-complete). Exit 0 when the mission completes.')
+    parser.add_argument('scenario', help='scenario file (YAML), or the name of an installed '
+                                         'one (e.g. truss)')
+    parser.add_argument('--panels', type=_positive(int), metavar='N',
+                        help="repeat the scenario's jobs N times (default: the file's)")
+    parser.add_argument('--time-scale', type=_positive(float), metavar='S',
+                        help="wall seconds per schedule unit (default: the params file's, "
+                             f'else {DEFAULT_TIME_SCALE:g})')
+    parser.add_argument('--params-file', type=Path, metavar='FILE',
+                        help='ROS parameters file passed to every node '
+                             '(e.g. config/params/paper_demo.yaml)')
+    parser.add_argument('--out', type=Path, metavar='DIR',
+                        help=f"where the monitor's outputs and the node logs go (default: "
+                             f'{default_out_dir()})')
+    parser.add_argument('--exit-on-complete', action='store_true',
+                        help='stop the fleet and exit once the mission has ended')
+    parser.add_argument('--timeout', type=_positive(float), metavar='S',
+                        help='give up (exit 1) if the mission has not ended after S seconds')
+    return parser.parse_args(argv)
+
+
+def _summary(status: MissionStatus | None) -> str:
+    if status is None:
+        return 'no mission status received'
+    state = {v: k[len('STATE_'):].lower() for k, v in vars(MissionStatus).items()
+             if k.startswith('STATE_')}.get(status.state, f'state {status.state}')
+    return f'{state}, {status.jobs_done}/{status.jobs_total} jobs done'
+
+
+def run(args: argparse.Namespace) -> int:
+    try:
+        fleet = Fleet(args.scenario, panels=args.panels, time_scale=args.time_scale,
+                      params_file=args.params_file, out=args.out,
+                      monitor={'exit_on_complete': True} if args.exit_on_complete else None)
+    except FleetError as error:
+        print(f'fleet: cannot run {args.scenario}:', file=sys.stderr)
+        for problem in error.problems:
+            print(f'  - {problem}', file=sys.stderr)
+        return EXIT_BAD_INPUT
+    try:
+        watch = Listener(name='fleet')
+    except RuntimeError as error:  # rclpy's RCLError, e.g. a bad ROS_DOMAIN_ID
+        print(f'fleet: could not start ROS: {error}', file=sys.stderr)
+        return EXIT_FAILED
+    latest: list[MissionStatus] = []
+    watch.subscribe(MissionStatus, MISSION_STATUS_TOPIC, LATCHED_QOS, latest.append)
+    ended: list[int] = []
+    """The mission's exit code, once it has ended."""
+    previous = {sig: signal.signal(sig, _stop_signal) for sig in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        fleet.start(stream_monitor=True)
+        robots = ', '.join(r.name for r in fleet.problem.robots)
+        print(f"fleet: scenario '{fleet.problem.name}' ({fleet.scenario}): planner, agents "
+              f'of {robots} and monitor started; node logs in {fleet.logs}', flush=True)
+        return _watch(fleet, latest, ended, args)
+    except _SignalError as stopped:
+        if ended:
+            return ended[0]
+        print(f'fleet: stopped by {stopped} before the mission ended '
+              f'({_summary(latest[-1] if latest else None)})', file=sys.stderr)
+        return stopped.code
+    finally:
+        # Stopping is bounded (SIGKILL after the grace period); a second Ctrl-C must not
+        # leave nodes behind by interrupting it.
+        for sig in previous:
+            signal.signal(sig, signal.SIG_IGN)
+        fleet.stop()
+        watch.close()
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+
+
+def _watch(fleet: Fleet, latest: list, ended: list, args) -> int:
+    """Until the outcome is decided: the exit code, its reason printed. Without
+    --exit-on-complete only a node's death or the timeout decides; Ctrl-C ends it."""
+    began = time.monotonic()
+    ended_at = None
+    while True:
+        time.sleep(0.1)
+        status = latest[-1] if latest else None
+        if not ended and status is not None:
+            code = _ended(status)
+            if code is not None:
+                ended.append(code)
+                ended_at = time.monotonic()
+                if not args.exit_on_complete:
+                    print('fleet: the fleet stays up; Ctrl-C stops it', flush=True)
+        if ended and args.exit_on_complete:
+            # Once complete, the monitor writes its summary and chart, then exits.
+            if ended[0] != 0 or fleet.processes[MONITOR_NODE].poll() is not None \
+                    or time.monotonic() - ended_at > MONITOR_FINISH:
+                return ended[0]
+        for name, code in fleet.exited().items():
+            if name == MONITOR_NODE and code == 0 and args.exit_on_complete:
+                continue  # it saw the mission end; the mission status decides above
+            print(f"fleet: node '{name}' exited with code {code} "
+                  f'({_summary(status)}); its log: {fleet.logs / name}.log', file=sys.stderr)
+            return EXIT_FAILED
+        if args.timeout and not ended and time.monotonic() - began > args.timeout:
+            print(f'fleet: the mission did not end within {args.timeout:g} s '
+                  f'({_summary(status)})', file=sys.stderr)
+            return EXIT_FAILED
+
+
+def _ended(status: MissionStatus) -> int | None:
+    """The exit code a mission that has ended with `status` gives (reason printed), or None
+    while it goes on."""
+    mission = status.mission_id or status.scenario_id
+    if status.state == MissionStatus.STATE_COMPLETE:
+        print(f"fleet: mission '{mission}' complete: {status.jobs_done}/{status.jobs_total} "
+              f'jobs done, makespan {status.projected_makespan:.2f} (planned '
+              f'{status.planned_makespan:.2f}) schedule units', flush=True)
+        return 0
+    if status.state in (MissionStatus.STATE_FAILED, MissionStatus.STATE_CANCELLED):
+        word = 'failed' if status.state == MissionStatus.STATE_FAILED else 'was cancelled'
+        reasons = '; '.join(status.blocked_reasons) or 'no reason given'
+        print(f"fleet: mission '{mission}' {word}: {reasons}", file=sys.stderr)
+        return EXIT_FAILED
+    return None
+
+
+def main(argv=None) -> int:
+    return run(parse_arguments(sys.argv[1:] if argv is None else argv))
+
+
+if __name__ == '__main__':
+    sys.exit(main())

@@ -1,0 +1,315 @@
+"""Test a fleet as it runs: real node processes on a private ROS domain, started by the fleet
+launcher, watched from the test through the public topics (see docs/testing.md).
+
+Enable the pytest fixture in a `conftest.py` with
+
+    pytest_plugins = ['fjsp_planner.testing']
+
+and a test that a robot failure is re-planned to completion reads
+
+    def test_losing_r1_mid_mission(fjsp_fleet):
+        fleet = fjsp_fleet('truss.yaml', time_scale=0.1).start()
+        fleet.wait_for(lambda o: o.schedule_time() >= 8, 60, 'schedule time 8')
+        fleet.inject_fault('R1', 'fail')
+        fleet.check_mission_complete(timeout=120)
+
+Each fleet gets a ROS_DOMAIN_ID of its own and keeps discovery on this host
+(ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST), so tests never hear each other; its processes are
+stopped (SIGINT, then SIGKILL) whatever the test does. Every wait is bounded and fails the
+test naming what it waited for.
+"""
+
+import fcntl
+import math
+import random
+import subprocess
+import tempfile
+import time
+from collections import Counter, defaultdict
+from fractions import Fraction
+
+import pytest
+
+from fjsp_common.contract import (
+    EVENTS_QOS,
+    JOB_STATES_TOPIC,
+    LATCHED_QOS,
+    MISSION_EVENTS_TOPIC,
+    MISSION_STATUS_TOPIC,
+    PLAN_TOPIC,
+    ROBOT_STATES_QOS,
+    ROBOT_STATES_TOPIC,
+    TASK_EVENTS_TOPIC,
+)
+from fjsp_msgs.msg import JobStates, MissionEvent, MissionStatus, Plan, RobotState, TaskEvent
+from fjsp_planner.core.problem import Problem
+from fjsp_planner.core.schedule import JobAssignment, Schedule
+from fjsp_planner.core.validate import validate
+from fjsp_planner.faults import inject_fault
+from fjsp_planner.fleet import Fleet, Listener, find_executable
+
+TEST_TIME_SCALE = 0.03
+"""Wall seconds per schedule unit: the paper's 32-unit mission takes about a second."""
+TEST_PLANNER = {'time_limit': 5.0, 'start_delay': 0.3}
+"""Planner parameters for tests: a first plan within 5 s, a mission start soon after it."""
+DISCOVERY_RANGE = 'LOCALHOST'
+
+DOMAINS = range(1, 101)
+"""ROS domain ids Fast DDS can use on one host (each maps to its own ports)."""
+
+
+class DomainClaim:
+    """A ROS domain id no other test on this machine uses while the claim is held: each id is
+    claimed with an exclusive lock on a file, released by `release` or when the process
+    dies. Without it, two test runs at once (two checkouts, CI and a developer) can share a
+    domain and hear each other's robots."""
+
+    def __init__(self):
+        start = random.randrange(len(DOMAINS))
+        for index in range(len(DOMAINS)):
+            domain = DOMAINS[(start + index) % len(DOMAINS)]
+            lock = open(f'{tempfile.gettempdir()}/fjsp-ros-domain-{domain}.lock', 'w')  # noqa: SIM115
+            try:
+                fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                lock.close()
+                continue
+            self.domain, self._lock = domain, lock
+            return
+        raise RuntimeError(f'every ROS domain id {DOMAINS.start}..{DOMAINS.stop - 1} is in '
+                           'use by other tests on this machine')
+
+    def release(self) -> None:
+        self._lock.close()
+
+
+class Observer(Listener):
+    """Records every public topic of one domain, from the test process."""
+
+    def __init__(self, domain: int):
+        super().__init__(domain, name='test_observer', discovery_range=DISCOVERY_RANGE)
+        self.plans: list[Plan] = []
+        self.events: list[TaskEvent] = []
+        self.mission_events: list[MissionEvent] = []
+        self.status: MissionStatus | None = None
+        self.job_states: JobStates | None = None
+        self.robots: dict[str, RobotState] = {}
+        """Latest state of each robot."""
+        self.robot_history: list[RobotState] = []
+        self.subscribe(Plan, PLAN_TOPIC, LATCHED_QOS, self.plans.append)
+        self.subscribe(TaskEvent, TASK_EVENTS_TOPIC, EVENTS_QOS, self.events.append)
+        self.subscribe(MissionEvent, MISSION_EVENTS_TOPIC, EVENTS_QOS,
+                       self.mission_events.append)
+        self.subscribe(MissionStatus, MISSION_STATUS_TOPIC, LATCHED_QOS,
+                       lambda msg: setattr(self, 'status', msg))
+        self.subscribe(JobStates, JOB_STATES_TOPIC, LATCHED_QOS,
+                       lambda msg: setattr(self, 'job_states', msg))
+        self.subscribe(RobotState, ROBOT_STATES_TOPIC, ROBOT_STATES_QOS, self._robot)
+
+    def _robot(self, msg: RobotState) -> None:
+        self.robots[msg.robot] = msg
+        self.robot_history.append(msg)
+
+    def wait_for(self, predicate, timeout: float, what: str = 'a condition') -> None:
+        """Wait until `predicate(observer)` holds; fail the test naming `what` after
+        `timeout` seconds."""
+        if not super().wait_for(lambda: predicate(self), timeout):
+            pytest.fail(f'timed out after {timeout:g} s waiting for {what}; last mission '
+                        f'status: {self.status}', pytrace=False)
+
+    def complete(self) -> bool:
+        return self.status is not None and self.status.state == MissionStatus.STATE_COMPLETE
+
+    def latest_revision(self) -> int:
+        return max((p.revision for p in self.plans), default=0)
+
+    def schedule_time(self) -> float:
+        """Schedule time now, from the first plan's mission start (-inf before any plan)."""
+        if not self.plans:
+            return -math.inf
+        start = self.plans[0].mission_start
+        return (time.time() - start.sec - start.nanosec * 1e-9) / self.plans[0].time_scale
+
+    def jobs_done(self) -> set[str]:
+        """Jobs declared done in their last attempt."""
+        return {e.job for e in valid_events(self.plans, self.events)
+                if e.kind == TaskEvent.KIND_JOB_DONE}
+
+
+class FleetHarness(Fleet):
+    """A `Fleet` on a private domain with an `observer` that records its topics from before
+    the first node starts. Defaults suit tests: TEST_TIME_SCALE, TEST_PLANNER, no monitor."""
+
+    def __init__(self, scenario=None, *, out, domain: int | None = None,
+                 time_scale: float | None = TEST_TIME_SCALE, planner: dict | None = None,
+                 env: dict | None = None, **options):
+        self.claim = DomainClaim() if domain is None else None
+        domain = self.claim.domain if domain is None else domain
+        super().__init__(scenario, out=out, domain=domain, time_scale=time_scale,
+                         planner={**TEST_PLANNER, **(planner or {})},
+                         env={'ROS_AUTOMATIC_DISCOVERY_RANGE': DISCOVERY_RANGE, **(env or {})},
+                         **options)
+        self.observer = Observer(domain)
+
+    def start(self, *, monitor: bool = False, stream_monitor: bool = False) -> 'FleetHarness':
+        super().start(monitor=monitor, stream_monitor=stream_monitor)
+        return self
+
+    def wait_for(self, predicate, timeout: float, what: str = 'a condition') -> None:
+        """`Observer.wait_for`: `predicate` gets the observer."""
+        self.observer.wait_for(predicate, timeout, what)
+
+    def inject_fault(self, robot: str, fault: str, factor: float | None = None,
+                     timeout: float = 10.0) -> str:
+        """`fjsp_planner.faults.inject_fault` from the observer's context, which has
+        discovered the fleet: the fault lands within milliseconds."""
+        return inject_fault(robot, fault, factor, node=self.observer.node, timeout=timeout)
+
+    def run(self, package: str, executable: str, *args,
+            timeout: float = 30.0) -> subprocess.CompletedProcess:
+        """Run a tool of the workspace (e.g. the `inject_fault` command) in this fleet's
+        domain, as a user's script would; its exit code and output."""
+        return subprocess.run([str(find_executable(package, executable)), *args],
+                              env=self.env, capture_output=True, text=True, timeout=timeout)
+
+    def check_mission_complete(self, timeout: float = 60.0) -> Schedule:
+        """Wait for the mission to complete, then check what a user relies on: every job of
+        the scenario done exactly once, the timeline the robots ran (rebuilt from their
+        events) valid, and the status agreeing. The executed timeline."""
+        problem = self.problem
+        jobs = {j.name for j in problem.jobs}
+        self.wait_for(lambda o: o.complete(), timeout, 'the mission to complete')
+        # The last job-done events and the status saying complete may come in either order;
+        # each agent's event history comes when its writer is discovered.
+        self.wait_for(lambda o: o.jobs_done() >= jobs and _operations_reported(o), 10,
+                      "every job-done event and every robot's operation reports")
+        with self.observer.lock:
+            plans, events = list(self.observer.plans), list(self.observer.events)
+            status = self.observer.status
+        check_jobs_done_once(problem, plans, events)
+        executed = check_executed_timeline(problem, plans, events)
+        assert (status.jobs_done, status.jobs_total, status.jobs_running) == \
+            (len(jobs), len(jobs), 0), status
+        return executed
+
+    def close(self) -> dict[str, int]:
+        try:
+            return self.stop()
+        finally:
+            self.observer.close()
+            if self.claim is not None:
+                self.claim.release()
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+
+def _operations_reported(observer: Observer) -> bool:
+    """Every operation the last plan gives a robot reported done in the job's last attempt."""
+    if not observer.plans:
+        return False
+    planned = {(r.robot, t.job) for r in observer.plans[-1].robots for t in r.tasks}
+    reported = {(e.robot, e.job) for e in valid_events(observer.plans, observer.events)
+                if e.kind == TaskEvent.KIND_OPERATION_DONE}
+    return planned <= reported
+
+
+@pytest.fixture
+def ros_domain():
+    """A ROS domain id of this test's own (`DomainClaim`), for processes it starts itself."""
+    claim = DomainClaim()
+    try:
+        yield claim.domain
+    finally:
+        claim.release()
+
+
+@pytest.fixture
+def fjsp_fleet(tmp_path):
+    """A factory of fleets under test: `fjsp_fleet(scenario, **options)` returns a
+    `FleetHarness` (not yet started) with its own domain and output directory; every fleet
+    it made is stopped after the test."""
+    made: list[FleetHarness] = []
+
+    def make(scenario=None, **options) -> FleetHarness:
+        fleet = FleetHarness(scenario, out=tmp_path / f'fleet{len(made) + 1}', **options)
+        made.append(fleet)
+        return fleet
+
+    try:
+        yield make
+    finally:
+        for fleet in made:
+            fleet.close()
+
+
+# --- what the robots did, from their events ----------------------------------------------
+
+def restart_revisions(plans) -> dict[str, int]:
+    """Per job, the last plan revision that (re)started it: its reports under older ones are
+    void (`PlanTask.continued`)."""
+    since = {}
+    for plan in plans:
+        for robot in plan.robots:
+            for task in robot.tasks:
+                if not task.continued:
+                    since[task.job] = max(since.get(task.job, 0), plan.revision)
+    return since
+
+
+def valid_events(plans, events) -> list[TaskEvent]:
+    """The events of each job's last attempt, the one that counts."""
+    since = restart_revisions(plans)
+    return [e for e in events if e.plan_revision >= since.get(e.job, 0)]
+
+
+def executed_timeline(problem: Problem, plans, events) -> Schedule:
+    """The schedule the robots actually ran, rebuilt from their task events alone (the last
+    attempt of each job), with each robot's operation as the plans that ran it gave it.
+    Jobs not (yet) finished by all their robots are left out."""
+    started, operation_done = defaultdict(dict), defaultdict(dict)
+    for e in valid_events(plans, events):
+        if e.kind == TaskEvent.KIND_STARTED:
+            started[e.job][e.robot] = e.time
+        elif e.kind == TaskEvent.KIND_OPERATION_DONE:
+            operation_done[e.job][e.robot] = e.time
+    tasks = {(r.robot, t.job): t for plan in plans for r in plan.robots for t in r.tasks}
+    jobs = {}
+    for job, robots in started.items():
+        if set(operation_done[job]) != set(robots):
+            continue
+        ops = {robot: tasks[robot, job].operation_type for robot in robots}
+        plan = tasks[next(iter(robots)), job].process_plan
+        end = max(operation_done[job].values())
+        jobs[job] = JobAssignment(job, plan, Fraction(min(robots.values())), Fraction(end), ops)
+    sequences = {r.name: tuple(sorted((j for j, a in jobs.items() if r.name in a.robots),
+                                      key=lambda j: jobs[j].start))
+                 for r in problem.robots}
+    return Schedule(jobs, sequences)
+
+
+def check_jobs_done_once(problem: Problem, plans, events) -> None:
+    """Every job of `problem` declared done exactly once in its last attempt, and nothing
+    else; AssertionError naming the jobs otherwise."""
+    done = Counter(e.job for e in valid_events(plans, {e.event_id: e for e in events}.values())
+                   if e.kind == TaskEvent.KIND_JOB_DONE)
+    jobs = {j.name for j in problem.jobs}
+    problems = [f"job '{j}' never done" for j in sorted(jobs - set(done))]
+    problems += [f"job '{j}' done {n} times" for j, n in sorted(done.items()) if n > 1]
+    problems += [f"job '{j}' done but not in the scenario" for j in sorted(set(done) - jobs)]
+    if problems:
+        raise AssertionError('; '.join(problems))
+
+
+def check_executed_timeline(problem: Problem, plans, events) -> Schedule:
+    """The executed timeline, which must cover every job and pass the validator;
+    AssertionError listing what is wrong otherwise."""
+    executed = executed_timeline(problem, plans, events)
+    missing = sorted({j.name for j in problem.jobs} - set(executed.jobs))
+    if missing:
+        raise AssertionError(f'no complete execution reported for {", ".join(missing)}')
+    problems = validate(problem, executed)
+    if problems:
+        raise AssertionError('the executed timeline is invalid:\n' + '\n'.join(problems))
+    return executed
+

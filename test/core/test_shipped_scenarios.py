@@ -1,0 +1,31 @@
+"""The scenarios shipped in config/scenarios/ besides the paper's: they load, and CP-SAT
+proves their optimum (the values their files state) with a schedule the validator accepts.
+The integration tests run them on the node network; this is where a broken file shows first.
+"""
+
+from fractions import Fraction
+from pathlib import Path
+
+import pytest
+
+from fjsp_planner.core.scenario import load_scenario
+from fjsp_planner.core.schedule import Status
+from fjsp_planner.core.solve import solve
+from fjsp_planner.core.validate import validate
+
+SCENARIOS = Path(__file__).resolve().parents[2] / 'config' / 'scenarios'
+
+
+@pytest.mark.parametrize(('scenario', 'optimum'), [
+    ('truss.yaml', Fraction(23)),
+    ('antenna.yaml', Fraction(88, 5)),
+])
+def test_shipped_scenario_is_proven_optimal(scenario, optimum):
+    problem = load_scenario(SCENARIOS / scenario)
+    assert any(r.start_location for r in problem.robots)
+    assert any(r.release_time > 0 for r in problem.robots)
+    assert any(len(j.plans) > 1 for j in problem.jobs) and problem.holding
+    result = solve(problem, time_limit=60, workers=2)
+    assert result.status == Status.OPTIMAL, result
+    assert result.makespan == optimum
+    assert validate(problem, result.schedule) == []
