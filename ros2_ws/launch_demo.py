@@ -86,7 +86,7 @@ def main(argv):
         print(f'demo: planner and agents started (logs in {logs}); monitor output follows',
               flush=True)
         monitor = start('monitor', 'fjsp_planner', 'monitor_node',
-                        ('gantt_dir', args.out.resolve()), ('exit_on_complete', 'true'),
+                        ('out_dir', args.out.resolve()), ('exit_on_complete', 'true'),
                         log=False)
         try:
             code = monitor.wait(timeout=args.timeout)

@@ -21,7 +21,8 @@ from harness import SCENARIO
      2, "parameter 'refresh_period' must be within [0.05, 60]"),
     (['run', 'no_such_package', 'x'], 1, "Package 'no_such_package' not found"),
     (['run', 'robot_agents', 'no_such_agent'], 1, 'No executable found'),
-    (['topic', 'list'], 2, 'not provided by this front end'),
+    (['bag', 'info', 'x.mcap'], 2, 'not provided by this front end'),
+    (['topic', 'echo', '/plan', '--spin-time', '-1'], 2, '--spin-time must be >= 0'),
 ])
 def test_bad_input_is_refused_clearly(launcher, command, code, message):
     done = subprocess.run(['ros2', *command], env=launcher.env, capture_output=True,

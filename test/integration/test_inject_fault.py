@@ -70,7 +70,7 @@ def test_helper_through_a_spun_node(launcher, observer):
 def test_monitor_shows_failed_then_offline(launcher, observer):
     launcher.start_agent('MARC1')
     launcher.start('monitor', 'fjsp_planner', 'monitor_node',
-                   [('refresh_period', 0.2), ('heartbeat_timeout', 0.6)])
+                   [('refresh_period', 0.2), ('heartbeat_timeout', 0.6), ('web_port', 0)])
     observer.wait_for(mode_is(observer, RobotState.MODE_IDLE), 20, 'the MARC1 agent')
     run(launcher, 'MARC1', 'fail')
     wait_for_line(launcher, 'monitor', 'MARC1      failed')

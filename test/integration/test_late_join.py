@@ -24,11 +24,12 @@ def test_agent_and_monitor_started_after_the_plan(launcher, observer, tmp_path):
 
     # A monitor started after the mission ended still gets plan, status and events.
     launcher.start('monitor', 'fjsp_planner', 'monitor_node',
-                   [('gantt_dir', tmp_path / 'gantt'), ('exit_on_complete', True)])
+                   [('out_dir', tmp_path / 'out'), ('exit_on_complete', True),
+                    ('web_port', 0)])
     code = launcher.processes['monitor'].wait(timeout=30)
     log = launcher.log('monitor')
     assert code == 0, log
-    assert 'complete: 12/12 jobs done' in log
-    assert len(list((tmp_path / 'gantt').glob('*.png'))) == 1
+    assert 'complete: 12/12 jobs done (planner: 12/12)' in log
+    assert len(list((tmp_path / 'out').glob('*.png'))) == 1
     assert observer.status.state == MissionStatus.STATE_COMPLETE
     assert observer.robots['MARC2'].mode == RobotState.MODE_IDLE

@@ -419,6 +419,12 @@ class MissionHistory:
     def ended(self) -> bool:
         return self.state is not None and self.state.ended
 
+    @property
+    def ended_at(self) -> float | None:
+        """Schedule time the planner first reported the mission ended (its later statuses
+        keep counting time, so this is what a live view and a replay agree on)."""
+        return next((s.elapsed for s in self.status_changes if s.state.ended), None)
+
     # --- robots --------------------------------------------------------------------------
 
     def spans(self, silent: Mapping[str, float] = {}) -> list[Span]:  # noqa: B006 (read only)
@@ -690,10 +696,11 @@ class FleetHistory:
         # Progress and heartbeats change the live view even when the trail does not.
         return True
 
-    def silent(self, mission: MissionHistory, now: float) -> dict[str, float]:
-        """The robots of `mission` silent at wall time `now`: robot -> its last stamp."""
+    def silent(self, mission: MissionHistory | None, now: float) -> dict[str, float]:
+        """Robots silent at wall time `now` (robot -> its last stamp): those following
+        `mission` or no mission yet; with `mission` None, every robot."""
         return {robot: state.stamp for robot, state in self.robots.items()
-                if state.mission_id == mission.mission_id
+                if (mission is None or state.mission_id in ('', mission.mission_id))
                 and now - state.stamp > self.heartbeat_timeout}
 
     def current(self) -> MissionHistory | None:

@@ -9,29 +9,33 @@ def _units(value) -> str:
     return '?' if value is None else f'{value:.2f}'
 
 
-def frame(header: dict, rows: list[dict]) -> tuple[str, tuple]:
+def frame(header: dict | None, rows: list[dict]) -> tuple[str, tuple]:
     """The frame's text, and its key: what a new frame must differ in to be printed. The key
-    leaves out what moves all the time (the clock, progress, the projected makespan)."""
+    leaves out what moves all the time (the clock, progress, the projected makespan). With
+    no mission (`header` None) it shows the robots that reported."""
     h = header
-    lines = [
-        f"mission {h['mission_id']} ({h['scenario']}), revision {h['revision']}: {h['state']}, "
-        f"{h['jobs_done']}/{h['jobs_total']} jobs done, {h['jobs_running']} running; makespan "
-        f"planned {_units(h['planned_makespan'])}, projected "
-        f"{_units(h['projected_makespan'])}; t={_units(h['time'])}"]
-    if any(h['ignored']):
-        stale, duplicate, unknown = h['ignored']
-        lines[0] += f'; ignored {stale} stale, {duplicate} duplicate, {unknown} unknown'
-    if h['revision'] > 1 and h['replan_reasons']:
-        lines.append(f"  re-planned because: {'; '.join(h['replan_reasons'])}")
-    lines += [f'  warning: {w}' for w in h['warnings']]
-    lines += [f'  blocked: {b}' for b in h['blocked_reasons']]
-    for row in rows:
-        lines.append('  ' + robot_line(row))
-    key = (h['mission_id'], h['state'], h['revision'], h['jobs_done'], h['jobs_running'],
-           h['jobs_total'], tuple(h['replan_reasons']), tuple(h['warnings']),
-           tuple(h['blocked_reasons']), tuple(h['ignored']),
-           tuple((r['robot'], r['mode'], r.get('job'), r.get('location'), r.get('destination'),
-                  r.get('detail')) for r in rows))
+    if h is None:
+        lines = ['no mission yet (is the planner running?)']
+        key = ()
+    else:
+        lines = [
+            f"mission {h['mission_id']} ({h['scenario']}), revision {h['revision']}: "
+            f"{h['state']}, {h['jobs_done']}/{h['jobs_total']} jobs done, {h['jobs_running']} "
+            f"running; makespan planned {_units(h['planned_makespan'])}, projected "
+            f"{_units(h['projected_makespan'])}; t={_units(h['time'])}"]
+        if any(h['ignored']):
+            stale, duplicate, unknown = h['ignored']
+            lines[0] += f'; ignored {stale} stale, {duplicate} duplicate, {unknown} unknown'
+        if h['revision'] > 1 and h['replan_reasons']:
+            lines.append(f"  re-planned because: {'; '.join(h['replan_reasons'])}")
+        lines += [f'  warning: {w}' for w in h['warnings']]
+        lines += [f'  blocked: {b}' for b in h['blocked_reasons']]
+        key = (h['mission_id'], h['state'], h['revision'], h['jobs_done'], h['jobs_running'],
+               h['jobs_total'], tuple(h['replan_reasons']), tuple(h['warnings']),
+               tuple(h['blocked_reasons']), tuple(h['ignored']))
+    lines += ['  ' + robot_line(row) for row in rows]
+    key += tuple((r['robot'], r['mode'], r.get('job'), r.get('location'),
+                  r.get('destination'), r.get('detail')) for r in rows)
     return '\n'.join(lines), key
 
 

@@ -21,8 +21,8 @@ def _number(value: float | None) -> float | None:
 
 def now_units(mission: MissionHistory, now: float) -> float | None:
     """Schedule time at wall time `now`; the mission's last known moment once it ended."""
-    if mission.ended and mission.status is not None:
-        return max(mission.status.elapsed, mission.executed_makespan() or 0.0)
+    if mission.ended_at is not None:
+        return max(mission.ended_at, mission.executed_makespan() or 0.0)
     return mission.units(now)
 
 
@@ -57,19 +57,26 @@ def header(mission: MissionHistory, now: float) -> dict:
     }
 
 
-def robot_rows(fleet: FleetHistory, mission: MissionHistory, now: float) -> list[dict]:
-    """One row per robot: what it does, where, and what it waits for."""
-    silent = fleet.silent(mission, now) if not mission.ended else {}
+def robot_rows(fleet: FleetHistory, mission: MissionHistory | None, now: float) -> list[dict]:
+    """One row per robot: what it does, where, and what it waits for. The robots of
+    `mission` (with their last state in it once it ended), then any robot following no
+    mission (e.g. refusing its plan); with no mission, every robot that reported."""
+    ended = mission is not None and mission.ended
+    silent = fleet.silent(mission, now) if not ended else {}
+    names = mission.robot_names() if mission is not None else []
+    names += sorted(r for r, s in fleet.robots.items() if r not in names
+                    and (mission is None or not s.mission_id))
     rows = []
-    for name in mission.robot_names():
+    for name in names:
         state = fleet.robots.get(name)
-        if state is None or state.mission_id != mission.mission_id:
+        if mission is not None and (state is None or state.mission_id not in
+                                    ('', mission.mission_id)):
             state = mission.last_state(name)
         if state is None:
             rows.append({'robot': name, 'mode': 'no report', 'detail': 'has not reported'})
             continue
         mode = RobotMode.OFFLINE if name in silent else state.mode
-        trail = mission.trails.get(name, [])
+        trail = mission.trails.get(name, []) if mission is not None else []
         since = mission.units(trail[-1].stamp) if trail else None
         rows.append({
             'robot': name,
@@ -84,7 +91,8 @@ def robot_rows(fleet: FleetHistory, mission: MissionHistory, now: float) -> list
             'refusal': state.refusal,
             'failures': state.failures,
             'since': _number(since),
-            'detail': _detail(mission, state, mode),
+            'detail': _detail(mission, state, mode) if mission is not None else
+            (f'refuses its plan: {state.refusal}' if state.refusal else ''),
         })
     return rows
 
