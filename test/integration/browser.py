@@ -38,6 +38,7 @@ def headless_browser(width: int = 1400, height: int = 1000):
     profile = tempfile.mkdtemp(prefix='fjsp-chromium-')
     options = webdriver.ChromeOptions()
     options.binary_location = browser
+    options.set_capability('goog:loggingPrefs', {'browser': 'ALL'})
     for flag in (*FLAGS, f'--user-data-dir={profile}', f'--window-size={width},{height}'):
         options.add_argument(flag)
     driver = webdriver.Chrome(service=Service(driver_path), options=options)

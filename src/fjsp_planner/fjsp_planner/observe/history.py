@@ -541,7 +541,7 @@ class MissionHistory:
                                         revision.number, reasons, counts),
                                    f'revision/{revision.number}',
                                    stamps.get(revision.number, math.nan)))
-        for span in self._recorded_spans():
+        for span in self._cached('spans', self._recorded_spans):
             kind = (MissionEventKind.ROBOT_FAILED if span.kind == 'failed'
                     else MissionEventKind.ROBOT_OFFLINE)
             items.append(StoryItem(span.start, kind, tell(kind, span.robot, '', 0, (), counts),
