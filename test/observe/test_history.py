@@ -21,6 +21,7 @@ from mission_facts import (
 
 from fjsp_common.vocabulary import EventKind, MissionEventKind, MissionState, RobotMode
 from fjsp_planner.observe.history import FleetHistory, Outcome
+from fjsp_planner.observe.story import story
 
 
 def history_of(facts, timeout=1.0) -> FleetHistory:
@@ -117,7 +118,7 @@ def test_the_same_history_whatever_order_the_topics_arrive_in():
         assert mission.attempts() == expected.attempts()
         assert mission.spans() == expected.spans()
         assert mission.counts() == expected.counts()
-        assert [i.key for i in mission.story()] == [i.key for i in expected.story()]
+        assert [i.key for i in story(mission)] == [i.key for i in story(expected)]
 
 
 def test_a_late_joiner_without_the_first_plan_groups_attempts_by_revision():
@@ -165,7 +166,7 @@ def test_the_planners_mission_events_decide_aborts_and_voids():
 
 def test_the_story_is_derived_when_the_planner_tells_none():
     mission = history_of(faulty_mission()).missions[MISSION]
-    lines = [(round(i.time, 6), i.text) for i in mission.story()]
+    lines = [(round(i.time, 6), i.text) for i in story(mission)]
     assert lines == [
         (-0.5, 'revision 1 planned: makespan 10 (optimal)'),
         (5.0, 'C failed'),
@@ -184,7 +185,7 @@ def test_the_story_is_the_planners_when_it_tells_one():
         mission_event(MissionEventKind.ROBOT_FAILED, 5.1, robot='C'),
         mission_event(MissionEventKind.PLAN_PUBLISHED, 5.5, revision=2,
                       reasons=["robot 'C' failed"])]
-    lines = [i.text for i in history_of(facts).missions[MISSION].story()]
+    lines = [i.text for i in story(history_of(facts).missions[MISSION])]
     assert lines == ['mission started: from demo.yaml', 'C failed',
                      "revision 2 planned: robot 'C' failed"]
 
@@ -196,7 +197,7 @@ def test_blocks_and_warnings_are_told_once_each():
              status(1.5, MissionState.EXECUTING, 0, 1, warnings=[warning]),
              status(2, MissionState.BLOCKED, 0, 1, blocked=["job 'J1' cannot be staffed"]),
              status(2.5, MissionState.BLOCKED, 0, 1, blocked=["job 'J1' cannot be staffed"])]
-    lines = [i.text for i in history_of(facts).missions[MISSION].story()]
+    lines = [i.text for i in story(history_of(facts).missions[MISSION])]
     assert lines[1:] == ["warning: robot 'Z' is not in the scenario",
                          "blocked: job 'J1' cannot be staffed"]
 

@@ -23,6 +23,7 @@ from fjsp_planner.observe.recording import (
     msg_files_under,
     replay,
 )
+from fjsp_planner.observe.story import story
 
 REPO = Path(__file__).resolve().parents[2]
 READ_MSG = msg_files_under(REPO / 'src', Path(sys.prefix) / 'share')
@@ -125,7 +126,7 @@ def test_round_trip_gives_the_same_history(tmp_path):
     assert replayed.attempts() == expected.attempts()
     assert replayed.spans() == expected.spans()
     assert replayed.counts() == expected.counts()
-    assert [i.text for i in replayed.story()] == [i.text for i in expected.story()]
+    assert [i.text for i in story(replayed)] == [i.text for i in story(expected)]
     assert reading.truncated == ''
     assert sum(reading.counts.values()) == len(facts)
     assert reading.types['/plan'] == 'fjsp_msgs/msg/Plan'

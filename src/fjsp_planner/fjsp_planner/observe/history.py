@@ -1,4 +1,4 @@
-"""The whole story of each mission, rebuilt from the facts the fleet publishes.
+"""The whole of each mission, rebuilt from the facts the fleet publishes.
 
 A plan revision replaces the one before it, so a view built from the latest plan forgets what
 was done under earlier ones. `MissionHistory` keeps every revision, every task event, every
@@ -9,9 +9,8 @@ mission event and every change of each robot's state, and derives from them:
   restarted it after it was done, e.g. a jig job whose holder failed);
 - each robot's **health spans**: failed (it said so) and offline (its heartbeat stopped);
 - each robot's **activities**: travelling, waiting, working, holding, idle;
-- the **revisions** with the reasons they were planned, and the **story**: one line per thing
-  that happened (the planner's mission events when it publishes them, else derived from the
-  facts above).
+- the **revisions** with the reasons they were planned (the story told from all this is in
+  `story`).
 
 Everything is derived on demand from sets of facts, so the result does not depend on the
 order in which messages of different topics arrive: the live monitor and a replay of the
@@ -29,7 +28,7 @@ time already requires).
 
 import math
 from collections import Counter, defaultdict
-from collections.abc import Iterable, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from enum import StrEnum
 
@@ -111,21 +110,6 @@ class Revision:
     makespan: float
     solver_status: str
     lower_bound: float
-
-
-@dataclass(frozen=True)
-class StoryItem:
-    """One line of the mission's story."""
-
-    time: float
-    kind: MissionEventKind
-    text: str
-    key: str
-    """Unique and stable: a line is told once however often the story is derived."""
-    stamp: float
-    """Wall time of the fact it comes from (the event's publication)."""
-    robot: str = ''
-    job: str = ''
 
 
 @dataclass(frozen=True)
@@ -280,7 +264,8 @@ class MissionHistory:
 
     # --- what it adds up to --------------------------------------------------------------
 
-    def _cached(self, name, compute):
+    def cached(self, name: str, compute):
+        """`compute()`, computed again only once a fact was added since."""
         if self._cached_version != self.version:
             self._cache.clear()
             self._cached_version = self.version
@@ -289,7 +274,7 @@ class MissionHistory:
         return self._cache[name]
 
     def revisions(self) -> list[Revision]:
-        return self._cached('revisions', self._revisions)
+        return self.cached('revisions', self._revisions)
 
     def _revisions(self) -> list[Revision]:
         revisions = {}
@@ -306,7 +291,7 @@ class MissionHistory:
         return [revisions[r] for r in sorted(revisions)]
 
     def attempts(self) -> list[Attempt]:
-        return self._cached('attempts', self._attempts)
+        return self.cached('attempts', self._attempts)
 
     def _attempts(self) -> list[Attempt]:
         restarts: dict[str, set[int]] = defaultdict(set)
@@ -392,7 +377,7 @@ class MissionHistory:
         return latest
 
     def counts(self) -> Counts:
-        return self._cached('counts', self._counts)
+        return self.cached('counts', self._counts)
 
     def _counts(self) -> Counts:
         latest = self.latest_attempts().values()
@@ -430,7 +415,7 @@ class MissionHistory:
     def spans(self, silent: Mapping[str, float] = {}) -> list[Span]:  # noqa: B006 (read only)
         """Health spans; `silent` names robots silent right now (robot -> last stamp), whose
         offline span is still open."""
-        spans = list(self._cached('spans', self._recorded_spans))
+        spans = list(self.cached('spans', self._recorded_spans))
         for robot, since in silent.items():
             start = self.units(since)
             if start is not None and robot in self.trails:
@@ -480,7 +465,7 @@ class MissionHistory:
                 if e.robot == robot and e.kind in kinds]
 
     def activities(self) -> list[Activity]:
-        return self._cached('activities', self._activities)
+        return self.cached('activities', self._activities)
 
     def _activities(self) -> list[Activity]:
         activities = []
@@ -507,142 +492,6 @@ class MissionHistory:
     def last_state(self, robot: str) -> RobotStateFact | None:
         trail = self.trails.get(robot)
         return trail[-1] if trail else None
-
-    # --- the story -----------------------------------------------------------------------
-
-    def story(self, silent: Mapping[str, float] = {}) -> list[StoryItem]:  # noqa: B006
-        """What happened, in order: the planner's mission events if it published any for
-        this mission, else told from the plans, task events, robot states and statuses."""
-        if self.mission_events:
-            items = self._cached('told', self._told)
-        else:
-            items = self._cached('derived', self._derived) + self._silent_items(silent)
-        return sorted(items, key=lambda i: (i.time, _TELLING_ORDER[i.kind], i.stamp, i.key))
-
-    def _told(self) -> list[StoryItem]:
-        counts = self.counts()
-        items = []
-        for e in self.mission_events.values():
-            items.append(StoryItem(e.time, e.kind, tell(e.kind, e.robot, e.job, e.revision,
-                                                        e.reasons, counts), e.event_id,
-                                   e.stamp, e.robot, e.job))
-        return items
-
-    def _derived(self) -> list[StoryItem]:
-        items = []
-        counts = self.counts()
-        stamps = {p.revision: p.stamp for p in self.plans.values()}
-        for revision in self.revisions():
-            reasons = revision.reasons or (
-                (f'makespan {revision.makespan:g} ({revision.solver_status})',)
-                if revision.number == 1 else ())
-            items.append(StoryItem(revision.published, MissionEventKind.PLAN_PUBLISHED,
-                                   tell(MissionEventKind.PLAN_PUBLISHED, '', '',
-                                        revision.number, reasons, counts),
-                                   f'revision/{revision.number}',
-                                   stamps.get(revision.number, math.nan)))
-        for span in self._cached('spans', self._recorded_spans):
-            kind = (MissionEventKind.ROBOT_FAILED if span.kind == 'failed'
-                    else MissionEventKind.ROBOT_OFFLINE)
-            items.append(StoryItem(span.start, kind, tell(kind, span.robot, '', 0, (), counts),
-                                   f'{span.kind}/{span.robot}/{span.start:.6f}',
-                                   self._stamp_at(span.start), span.robot))
-            if span.end is not None:
-                items.append(StoryItem(span.end, MissionEventKind.ROBOT_BACK,
-                                       tell(MissionEventKind.ROBOT_BACK, span.robot, '', 0, (),
-                                            counts),
-                                       f'back/{span.robot}/{span.end:.6f}',
-                                       self._stamp_at(span.end), span.robot))
-        for attempt in self.attempts():
-            if attempt.outcome in (Outcome.ABORTED, Outcome.VOIDED) \
-                    and attempt.outcome_time is not None:
-                kind = (MissionEventKind.JOB_ABORTED if attempt.outcome == Outcome.ABORTED
-                        else MissionEventKind.JOB_VOIDED)
-                items.append(StoryItem(attempt.outcome_time, kind,
-                                       tell(kind, '', attempt.job, 0, (attempt.reason,), counts),
-                                       f'{attempt.outcome}/{attempt.job}/{attempt.number}',
-                                       self._stamp_at(attempt.outcome_time), job=attempt.job))
-        items += self._status_items(counts)
-        return items
-
-    def _status_items(self, counts: Counts) -> list[StoryItem]:
-        items = []
-        warned: set[str] = set()
-        ending = {MissionState.COMPLETE: MissionEventKind.MISSION_COMPLETE,
-                  MissionState.CANCELLED: MissionEventKind.MISSION_CANCELLED,
-                  MissionState.FAILED: MissionEventKind.MISSION_FAILED}
-        previous = None
-        for status in self.status_changes:
-            if status.state == MissionState.BLOCKED and (
-                    previous is None or previous.state != MissionState.BLOCKED
-                    or previous.blocked_reasons != status.blocked_reasons):
-                items.append(StoryItem(status.elapsed, MissionEventKind.BLOCKED,
-                                       tell(MissionEventKind.BLOCKED, '', '', status.revision,
-                                            status.blocked_reasons, counts),
-                                       f'blocked/{status.stamp:.6f}', status.stamp))
-            for warning in status.warnings:
-                if warning not in warned:
-                    warned.add(warning)
-                    items.append(StoryItem(status.elapsed, MissionEventKind.WARNING,
-                                           tell(MissionEventKind.WARNING, '', '', 0,
-                                                (warning,), counts),
-                                           f'warning/{warning}', status.stamp))
-            if status.state in ending and (previous is None or previous.state != status.state):
-                kind = ending[status.state]
-                items.append(StoryItem(status.elapsed, kind,
-                                       tell(kind, '', '', status.revision,
-                                            status.blocked_reasons, counts),
-                                       f'{status.state}', status.stamp))
-            previous = status
-        return items
-
-    def _silent_items(self, silent: Mapping[str, float]) -> list[StoryItem]:
-        items = []
-        for robot, since in silent.items():
-            start = self.units(since)
-            if start is not None and robot in self.trails:
-                items.append(StoryItem(start, MissionEventKind.ROBOT_OFFLINE,
-                                       tell(MissionEventKind.ROBOT_OFFLINE, robot, '', 0, (),
-                                            self.counts()),
-                                       f'offline/{robot}/{start:.6f}', since, robot))
-        return items
-
-    def _stamp_at(self, time: float) -> float:
-        plan = self.first_plan
-        return plan.mission_start + time * plan.time_scale if plan else math.nan
-
-
-_TELLING_ORDER = {kind: index for index, kind in enumerate(MissionEventKind)}
-"""Of things at the same time, causes first: a robot fails, its job aborts, a re-plan."""
-
-
-def tell(kind: MissionEventKind, robot: str, job: str, revision: int,
-         reasons: Iterable[str], counts: Counts) -> str:
-    """The story line of one event, in plain words."""
-    why = '; '.join(r for r in reasons if r)
-    because = f': {why}' if why else ''
-    if kind == MissionEventKind.PLAN_PUBLISHED:
-        return f'revision {revision} planned{because}'
-    if kind == MissionEventKind.MISSION_STARTED:
-        return f'mission started{because}'
-    if kind == MissionEventKind.ROBOT_FAILED:
-        return f'{robot} failed{because}'
-    if kind == MissionEventKind.ROBOT_OFFLINE:
-        return f'{robot} offline: heartbeat lost{because}'
-    if kind == MissionEventKind.ROBOT_BACK:
-        return f'{robot} back in service{because}'
-    if kind == MissionEventKind.JOB_ABORTED:
-        return f'job {job} aborted{because}'
-    if kind == MissionEventKind.JOB_VOIDED:
-        return f'job {job} voided{because}'
-    if kind == MissionEventKind.BLOCKED:
-        return f'blocked{because}'
-    if kind == MissionEventKind.WARNING:
-        return f'warning{because}'
-    if kind == MissionEventKind.JOBS_ADDED:
-        return f'jobs added: {job}{because}'
-    done = f'{counts.done}/{counts.total} jobs done'
-    return f'{kind}: {done}{because}'
 
 
 class FleetHistory:

@@ -9,6 +9,7 @@ import math
 
 from fjsp_common.vocabulary import EventKind, RobotMode
 from fjsp_planner.observe.history import FleetHistory, MissionHistory, Outcome
+from fjsp_planner.observe.story import story as told
 
 SHOWN_PLANS = 2
 """Planned lanes in the timeline: the first revision and the latest one."""
@@ -183,7 +184,7 @@ def story(fleet: FleetHistory, mission: MissionHistory, now: float) -> list[dict
     silent = fleet.silent(mission, now) if not mission.ended else {}
     return [{'key': i.key, 'time': _number(i.time), 'kind': str(i.kind), 'text': i.text,
              'robot': i.robot, 'job': i.job, 'stamp': _number(i.stamp)}
-            for i in mission.story(silent)]
+            for i in told(mission, silent)]
 
 
 def missions(fleet: FleetHistory) -> list[dict]:
