@@ -190,11 +190,13 @@ def main(argv) -> int:
     parser.add_argument('--screenshots', type=Path, default=None,
                         help='save the page mid-mission and at the end into this directory')
     parser.add_argument('--show', type=int, default=5, help='slowest lines to list')
+    parser.add_argument('--out', type=Path, default=None,
+                        help='keep the recording and the charts in this directory')
     args = parser.parse_args(argv)
     with tempfile.TemporaryDirectory(prefix='fjsp-bench-observe-') as scratch:
         logs = Path(scratch) / 'logs'
         logs.mkdir()
-        run(args, logs, Path(scratch) / 'out')
+        run(args, logs, args.out or Path(scratch) / 'out')
     return 0
 
 

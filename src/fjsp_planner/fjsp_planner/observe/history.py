@@ -191,16 +191,17 @@ class MissionHistory:
         return self._changed(event.stamp)
 
     def add_status(self, status: StatusFact) -> bool:
-        if self.status is not None and status.stamp < self.status.stamp:
+        """Whether it is news. Only a change of state or reasons changes what is derived
+        (`version`); the clock and counters in every periodic status do not."""
+        if self.status is not None and status.stamp <= self.status.stamp:
             return False
-        changed = self.status is None or self.status != status
         self.status = status
+        self.last_stamp = max(self.last_stamp, status.stamp)
         if not self.status_changes or _status_key(self.status_changes[-1]) != \
                 _status_key(status):
             self.status_changes.append(status)
-        if changed:
             self._changed(status.stamp)
-        return changed
+        return True
 
     def add_robot_state(self, state: RobotStateFact) -> bool:
         trail = self.trails[state.robot]

@@ -151,9 +151,9 @@ def timeline(fleet: FleetHistory, mission: MissionHistory, now: float) -> dict:
             for t in plan.tasks]})
     work = []
     for attempt in mission.attempts():
-        for robot, start in attempt.started.items():
+        for robot in attempt.robots:
             work.append({'robot': robot, 'job': attempt.job, 'attempt': attempt.number,
-                         'start': _number(start), 'end': _number(attempt.finish),
+                         'start': _number(attempt.started[robot]), 'end': _number(attempt.finish),
                          'open': attempt.finish is None, 'outcome': str(attempt.outcome),
                          'outcome_time': _number(attempt.outcome_time),
                          'reason': attempt.reason})
