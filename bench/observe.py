@@ -8,8 +8,10 @@ and recovers it a while later, and measures:
 - CPU (mean over the mission, from /proc) and resident memory (peak and at the end) of the
   monitor and the recorder processes;
 - the page's latency: for each line of the story, from the publication of the fact it tells
-  (the message's stamp) to the moment the page first showed it (the page notes Date.now()
-  for each line; browser and nodes share this host's clock);
+  (the message's stamp) to the moment the page first showed it; and for each change of a
+  robot's mode or job, from the stamp of the robot state that changed it to the moment the
+  robots table showed it (the page notes Date.now() for both; browser and nodes share this
+  host's clock);
 - the recording's size and message count.
 
 `--screenshots DIR` also saves the page mid-mission (after the re-plan) and at the end.
@@ -34,7 +36,12 @@ sys.path.insert(0, str(REPO / 'test' / 'integration'))
 from browser import find_chromium, headless_browser  # noqa: E402
 from harness import ROBOTS, Launcher, Observer, new_domain  # noqa: E402
 
-from fjsp_msgs.msg import MissionStatus  # noqa: E402
+from fjsp_common.contract import (  # noqa: E402
+    MODE_FROM_MSG,
+    ROBOT_STATES_QOS,
+    ROBOT_STATES_TOPIC,
+)
+from fjsp_msgs.msg import MissionStatus, RobotState  # noqa: E402
 from fjsp_planner.faults import inject_fault  # noqa: E402
 
 TICKS = os.sysconf('SC_CLK_TCK')
@@ -71,6 +78,34 @@ def wait_listening(port: int, timeout: float) -> None:
             time.sleep(0.2)
 
 
+def record_robot_states(observer) -> list:
+    """Every robot state, as the monitor reads them (the harness's observer keeps only the
+    latest of each writer, and would miss short-lived states)."""
+    states = []
+    observer.node.create_subscription(RobotState, ROBOT_STATES_TOPIC, states.append,
+                                      ROBOT_STATES_QOS)
+    return states
+
+
+def robot_changes_shown(history, shown) -> list[tuple[float, str]]:
+    """Seconds from each robot state that changed a robot's mode or job to the page showing
+    the change (changes the page never showed, being shorter than an update, are left out)."""
+    changes = {}
+    last = {}
+    for state in history:
+        key = (str(MODE_FROM_MSG.get(state.mode)), state.current_job)
+        if last.get(state.robot) != key:
+            last[state.robot] = key
+            stamp = state.stamp.sec + state.stamp.nanosec * 1e-9
+            changes.setdefault((state.robot, *key), []).append(stamp)
+    latencies = []
+    for robot, mode, job, at in shown:
+        stamps = [s for s in changes.get((robot, mode, job), []) if s <= at / 1000]
+        if stamps:
+            latencies.append((at / 1000 - max(stamps), f'{robot} {mode} {job}'.strip()))
+    return latencies
+
+
 def percentile(values, share):
     ordered = sorted(values)
     return ordered[min(len(ordered) - 1, int(share * len(ordered)))]
@@ -81,6 +116,7 @@ def run(args, logs: Path, out: Path) -> None:
     port = free_port()
     launcher = Launcher(domain, logs)
     observer = Observer(domain)
+    robot_states = record_robot_states(observer)
     page = None
     browser = None
     try:
@@ -88,11 +124,6 @@ def run(args, logs: Path, out: Path) -> None:
                                   [('out_dir', out), ('file_name', 'bench.mcap')])
         monitor = launcher.start('monitor', 'fjsp_planner', 'monitor_node',
                                  [('out_dir', out), ('web_port', port)])
-        launcher.start_planner(time_scale=args.time_scale, panels=args.panels,
-                               time_limit=args.time_limit,
-                               replan_time_limit=args.replan_time_limit)
-        for robot, _ in ROBOTS:
-            launcher.start_agent(robot)
         if find_chromium() is not None:
             wait_listening(port, 30)
             browser = headless_browser()
@@ -101,6 +132,12 @@ def run(args, logs: Path, out: Path) -> None:
         else:
             print('Chromium not found: no latency figures (apt-get install chromium '
                   'chromium-driver)')
+        # The page is open before the mission starts, so it sees all of it.
+        launcher.start_planner(time_scale=args.time_scale, panels=args.panels,
+                               time_limit=args.time_limit,
+                               replan_time_limit=args.replan_time_limit)
+        for robot, _ in ROBOTS:
+            launcher.start_agent(robot)
         observer.wait_for(lambda o: o.plans and o.status.state == MissionStatus.STATE_EXECUTING,
                           args.timeout, 'the first plan')
         planned = observer.plans[0].makespan
@@ -137,8 +174,10 @@ def run(args, logs: Path, out: Path) -> None:
         cpu = {name: cpu_seconds(pid) - start_cpu[name] for name, pid in samples.items()}
         memory = {name: memory_mb(pid) for name, pid in samples.items()}
         time.sleep(3.0)  # the page shows the end; the monitor draws it
-        latencies = []
+        latencies, robot_latencies = [], []
         if page is not None:
+            robot_latencies = robot_changes_shown(
+                list(robot_states), page.execute_script('return window.fjspRobotsShown'))
             shown = page.execute_script('return window.fjspShown')
             story = page.execute_script('return window.fjspData.story') or []
             for item in story:
@@ -170,6 +209,14 @@ def run(args, logs: Path, out: Path) -> None:
                   f'max {1000 * max(values):.0f} ms')
             for lat, kind, text in sorted(latencies, key=lambda x: -x[0])[:args.show]:
                 print(f'  {1000 * lat:7.0f} ms  {kind}: {text}')
+        if robot_latencies:
+            values = [lat for lat, _ in robot_latencies]
+            print(f'page latency, robot state published -> robots table shows it '
+                  f'({len(values)} changes): p50 {1000 * statistics.median(values):.0f} ms, '
+                  f'p95 {1000 * percentile(values, 0.95):.0f} ms, '
+                  f'max {1000 * max(values):.0f} ms')
+            for lat, change in sorted(robot_latencies, reverse=True)[:args.show]:
+                print(f'  {1000 * lat:7.0f} ms  {change}')
     finally:
         if browser is not None:
             browser.__exit__(None, None, None)

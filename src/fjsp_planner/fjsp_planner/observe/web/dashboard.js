@@ -3,8 +3,11 @@
 'use strict';
 
 const data = {};
-// When each story line was first shown (Date.now()), for measuring the page's latency.
+// When each story line was first shown, and each change of a robot's mode or job
+// ([robot, mode, job, Date.now()]), for measuring the page's latency.
 window.fjspShown = {};
+window.fjspRobotsShown = [];
+const shownRow = {};
 window.fjspData = data;
 
 // matplotlib's tab20, so a job has the same colour here as in the PNG chart.
@@ -75,6 +78,11 @@ function renderRobots() {
   const body = $('robots').tBodies[0];
   body.replaceChildren();
   for (const r of data.robots || []) {
+    const key = `${r.mode}/${r.job || ''}`;
+    if (shownRow[r.robot] !== key) {
+      shownRow[r.robot] = key;
+      window.fjspRobotsShown.push([r.robot, r.mode, r.job || '', Date.now()]);
+    }
     const row = element('tr', {'data-robot': r.robot});
     row.appendChild(element('td', {class: 'name'}, r.robot));
     row.appendChild(element('td', {class: 'type'}, r.type || ''));
