@@ -181,7 +181,10 @@ def run(args, logs: Path, out: Path) -> None:
             shown = page.execute_script('return window.fjspShown')
             story = page.execute_script('return window.fjspData.story') or []
             for item in story:
-                if item['key'] in shown and item['stamp'] is not None:
+                # An offline line is inferred from messages that did not come: no stamp to
+                # measure from.
+                if item['key'] in shown and item['stamp'] is not None \
+                        and item['kind'] != 'robot offline':
                     latencies.append((shown[item['key']] / 1000 - item['stamp'],
                                       item['kind'], item['text']))
             if args.screenshots:

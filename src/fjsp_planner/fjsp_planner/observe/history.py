@@ -371,6 +371,10 @@ class MissionHistory:
         return Attempt(**base, outcome=Outcome.RUNNING, finish=None, outcome_time=None)
 
     def latest_attempts(self) -> dict[str, Attempt]:
+        """Each job's latest attempt."""
+        return self.cached('latest', self._latest_attempts)
+
+    def _latest_attempts(self) -> dict[str, Attempt]:
         latest = {}
         for attempt in self.attempts():
             if attempt.job not in latest or attempt.number > latest[attempt.job].number:
