@@ -2,8 +2,7 @@
 answers to bad input (exit 1 with a one-line reason, exit 2 for bad arguments)."""
 
 import pytest
-from mission_facts import MISSION, faulty_mission
-from test_recording import record
+from mission_facts import MISSION, faulty_mission, record
 
 from fjsp_planner.observe.replay import main
 
