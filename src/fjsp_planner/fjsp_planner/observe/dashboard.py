@@ -10,6 +10,7 @@ monitor's executor only calls `publish`.
 """
 
 import json
+import sys
 import threading
 from http import HTTPStatus
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
@@ -24,6 +25,15 @@ KEEPALIVE = 15.0
 """Seconds between comments sent to an idle page, so a closed one is noticed."""
 
 
+class _Server(ThreadingHTTPServer):
+    daemon_threads = True
+
+    def handle_error(self, request, client_address):
+        """A page closed mid-request is routine; anything else is reported as usual."""
+        if not isinstance(sys.exc_info()[1], ConnectionError):
+            super().handle_error(request, client_address)
+
+
 class Dashboard:
     """An HTTP server for the page and its updates; `publish` the data, `close` when done."""
 
@@ -34,8 +44,7 @@ class Dashboard:
         self._version = 0
         self._closing = False
         self._condition = threading.Condition()
-        self._server = ThreadingHTTPServer((host, port), self._handler())
-        self._server.daemon_threads = True
+        self._server = _Server((host, port), self._handler())
         self._thread = threading.Thread(target=self._server.serve_forever,
                                         name='dashboard', daemon=True)
         self._thread.start()
@@ -129,7 +138,7 @@ class Dashboard:
 
                 try:
                     dashboard._stream(write)
-                except (BrokenPipeError, ConnectionResetError, TimeoutError):
+                except (ConnectionError, TimeoutError):
                     pass
 
             def log_message(self, format, *args):  # noqa: A002  (http.server's signature)
