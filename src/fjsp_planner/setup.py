@@ -8,6 +8,7 @@ setup(
     name=package_name,
     version='0.1.0',
     packages=find_packages(exclude=['test']),
+    package_data={'fjsp_planner.observe': ['web/*']},
     data_files=[
         ('share/ament_index/resource_index/packages', ['resource/' + package_name]),
         ('share/' + package_name, ['package.xml']),
@@ -25,6 +26,8 @@ setup(
             'fjsp-solve = fjsp_planner.cli:main',
             'planner_node = fjsp_planner.nodes.planner:main',
             'monitor_node = fjsp_planner.nodes.monitor:main',
+            'recorder = fjsp_planner.nodes.recorder:main',
+            'replay = fjsp_planner.observe.replay:run',
             'inject_fault = fjsp_planner.faults:main',
             'mission = fjsp_planner.missions:main',
             'fleet = fjsp_planner.fleet:main',

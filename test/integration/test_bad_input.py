@@ -29,7 +29,6 @@ SCENARIO = Path(__file__).resolve().parents[2] / 'config' / 'scenarios' / 'solar
      2, "parameter 'refresh_period' must be within [0.05, 60]"),
     (['run', 'no_such_package', 'x'], 1, "Package 'no_such_package' not found"),
     (['run', 'robot_agents', 'no_such_agent'], 1, 'No executable found'),
-    (['topic', 'list'], 2, 'not provided by this front end'),
     (['run', 'fjsp_planner', 'fleet'], 2, 'the following arguments are required: scenario'),
     (['run', 'fjsp_planner', 'fleet', 'no_such_scenario'], 2,
      'no_such_scenario: no such scenario file (installed: antenna.yaml, solar_panel.yaml, '
@@ -40,6 +39,8 @@ SCENARIO = Path(__file__).resolve().parents[2] / 'config' / 'scenarios' / 'solar
      "argument --time-scale: expected a number > 0, got 'fast'"),
     (['run', 'fjsp_planner', 'fleet', 'truss', '--params-file', '/no/such.yaml'], 2,
      '/no/such.yaml: cannot read parameters file: No such file or directory'),
+    (['bag', 'info', 'x.mcap'], 2, 'not provided by this front end'),
+    (['topic', 'echo', '/plan', '--spin-time', '-1'], 2, '--spin-time must be >= 0'),
 ])
 def test_bad_input_is_refused_clearly(command, code, message, ros_domain):
     env = dict(os.environ, ROS_DOMAIN_ID=str(ros_domain),

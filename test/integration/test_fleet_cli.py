@@ -73,10 +73,12 @@ def test_a_complete_mission_exits_0(tmp_path, ros_domain):
     assert "mission 'solar_panel-" in out and 'complete: 12/12 jobs done' in out
     assert '[monitor]' in out  # the monitor's view is streamed
     assert 'Traceback' not in out + err
-    assert len(list(tmp_path.glob('solar_panel_*.png'))) == 1
+    assert len(list(tmp_path.glob('solar_panel-*.png'))) == 1
+    assert len(list(tmp_path.glob('fjsp_*.mcap'))) == 1  # the flight recording
+    assert (tmp_path / 'fleet.key').is_file() and 'authenticated with the key' in out
     assert sorted(p.name for p in (tmp_path / 'logs').iterdir()) == [
         'agent_Assembler.log', 'agent_LSMS.log', 'agent_MARC1.log', 'agent_MARC2.log',
-        'monitor.log', 'planner.log']
+        'monitor.log', 'planner.log', 'recorder.log']
     assert not still_running(nodes, 1.0)
 
 

@@ -130,7 +130,7 @@ def test_helper_works_however_the_callers_node_is_spun(fjsp_fleet, spun):
 
 def test_monitor_shows_failed_then_offline(fjsp_fleet):
     fleet = marc1_agent(fjsp_fleet)
-    fleet.start_monitor(refresh_period=0.2, heartbeat_timeout=0.6)
+    fleet.start_monitor(refresh_period=0.2, heartbeat_timeout=0.6, web_port=0)
     run(fleet, 'MARC1', 'fail')
     wait_for_line(fleet, 'monitor', 'MARC1      failed')
     fleet.kill('agent_MARC1')

@@ -35,12 +35,12 @@ def test_agent_and_monitor_started_after_the_plan(fjsp_fleet, tmp_path):
     assert not fleet.observer.status.warnings
 
     # A monitor started after the mission ended still gets plan, status and events.
-    monitor = fleet.start_monitor(gantt_dir=tmp_path / 'gantt', exit_on_complete=True)
+    monitor = fleet.start_monitor(out_dir=tmp_path / 'out', exit_on_complete=True, web_port=0)
     code = monitor.wait(timeout=30)
     log = fleet.log('monitor')
     assert code == 0, log
-    assert 'complete' in log
-    assert len(list((tmp_path / 'gantt').glob('*.png'))) == 1
+    assert 'complete: 12/12 jobs done (planner: 12/12)' in log
+    assert len(list((tmp_path / 'out').glob('*.png'))) == 1
     assert fleet.observer.status.state == MissionStatus.STATE_COMPLETE
     assert fleet.observer.robots['MARC2'].mode == RobotState.MODE_IDLE
 

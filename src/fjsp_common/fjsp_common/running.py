@@ -9,12 +9,13 @@ start-up (`-p`, `--params-file`) and at run time alike.
 
 import re
 import signal
+import threading
 from collections.abc import Callable
 
 import rclpy
 from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
 from rclpy.exceptions import InvalidParameterTypeException, InvalidParameterValueException
-from rclpy.executors import ExternalShutdownException
+from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.node import Node
 
 
@@ -75,21 +76,30 @@ STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
 
 def run_node(make_node: Callable[[], Node], logger: str, args=None,
-             spin: Callable[[Node], None] = rclpy.spin) -> int:
-    """Build the node, spin it until shutdown, clean up; the process's exit code.
+             done: Callable[[Node], bool] = lambda node: False) -> int:
+    """Build the node, spin it until Ctrl-C, SIGTERM or `done(node)`, clean up; the process's
+    exit code.
 
-    SIGTERM stops the node like Ctrl-C does (rclpy would otherwise leave the process to
-    die without destroying its node), and a node still building its state when the signal
-    comes stops too.
+    rclpy's own signal handling is off: it shuts the context down under running callbacks
+    (an RCLError "context is not valid" when one publishes). While the node is being built, a
+    signal interrupts that work at once (a huge scenario stops loading); once it spins, a
+    signal only asks the spin loop to stop, between callbacks — raising it from the handler
+    could land in a finaliser, where Python swallows it and the node would spin on.
     """
     rclpy.init(args=args, signal_handler_options=rclpy.signals.SignalHandlerOptions.NO)
+    stop = threading.Event()
     for sig in STOP_SIGNALS:
         signal.signal(sig, _interrupt)
     node = None
     code = 0
     try:
         node = make_node()
-        spin(node)
+        for sig in STOP_SIGNALS:
+            signal.signal(sig, lambda signum, frame: stop.set())
+        executor = SingleThreadedExecutor()
+        executor.add_node(node)
+        while not stop.is_set() and not done(node) and rclpy.ok():
+            executor.spin_once(timeout_sec=SPIN_CHECK)
     except ParameterError as error:
         rclpy.logging.get_logger(logger).error(str(error))
         code = 2
@@ -107,6 +117,10 @@ def run_node(make_node: Callable[[], Node], logger: str, args=None,
                 pass
         rclpy.try_shutdown()
     return code
+
+
+SPIN_CHECK = 0.1
+"""Seconds a spinning node may take to notice a stop request when nothing else wakes it."""
 
 
 def _interrupt(signum, frame):

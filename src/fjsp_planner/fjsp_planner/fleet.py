@@ -33,6 +33,7 @@ import yaml
 from ament_index_python.packages import get_package_prefix
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 
+from fjsp_common.auth import KEY_FILE_VARIABLE, new_key
 from fjsp_common.contract import LATCHED_QOS, MISSION_STATUS_TOPIC
 from fjsp_msgs.msg import MissionStatus
 from fjsp_planner.core.problem import Problem, ProblemError
@@ -42,7 +43,8 @@ from robot_agents.agent_node import agent_node_name
 
 PLANNER_NODE = 'planner'
 MONITOR_NODE = 'monitor'
-MONITOR_OUT_PARAMETER = 'gantt_dir'
+RECORDER_NODE = 'recorder'
+MONITOR_OUT_PARAMETER = 'out_dir'
 """The monitor's parameter naming the directory its outputs go to."""
 DEFAULT_SCENARIO = 'solar_panel.yaml'
 DEFAULT_TIME_SCALE = 0.2
@@ -189,7 +191,7 @@ class Fleet:
                  time_scale: float | None = None, params_file=None, out=None,
                  domain: int | None = None, env: dict | None = None,
                  planner: dict | None = None, agents: dict | None = None,
-                 monitor: dict | None = None):
+                 monitor: dict | None = None, key: bool = False):
         problems = []
         self.scenario = resolve_scenario(scenario)
         self.problem: Problem | None = None
@@ -231,18 +233,30 @@ class Fleet:
         self.domain = domain
         self.extra = {PLANNER_NODE: dict(planner or {}), 'agents': dict(agents or {}),
                       MONITOR_NODE: dict(monitor or {})}
+        self.key_file: Path | None = None
+        """With `key`, a fresh fleet key, given to every node and to the tools run with
+        this fleet's environment (FJSP_FLEET_KEY_FILE)."""
+        if key:
+            self.key_file = new_key(self.out / 'fleet.key')
+            self.env[KEY_FILE_VARIABLE] = str(self.key_file)
+            for params in self.extra.values():
+                params.setdefault('fleet_key_file', self.key_file)
         self.processes: dict[str, subprocess.Popen] = {}
         self._streams: list[threading.Thread] = []
 
     # --- starting --------------------------------------------------------------------
 
-    def start(self, *, monitor: bool = True, stream_monitor: bool = False) -> 'Fleet':
-        """The planner, an agent for every robot of the scenario, and the monitor."""
+    def start(self, *, monitor: bool = True, stream_monitor: bool = False,
+              recorder: bool = False) -> 'Fleet':
+        """The planner, an agent for every robot of the scenario, the monitor, and the
+        recorder of the mission's topics."""
+        if recorder:
+            self.start_recorder()
+        if monitor:
+            self.start_monitor(stream=stream_monitor)
         self.start_planner()
         for robot in self.problem.robots:
             self.start_agent(robot.name)
-        if monitor:
-            self.start_monitor(stream=stream_monitor)
         return self
 
     def start_planner(self, **params) -> subprocess.Popen:
@@ -271,6 +285,11 @@ class Fleet:
             own[MONITOR_OUT_PARAMETER] = self.out
         return self.start_node(MONITOR_NODE, 'fjsp_planner', 'monitor_node',
                                {**own, **self.extra[MONITOR_NODE], **params}, stream=stream)
+
+    def start_recorder(self, **params) -> subprocess.Popen:
+        """The flight recorder: every mission topic into `<out>/fjsp_<time>.mcap`."""
+        return self.start_node(RECORDER_NODE, 'fjsp_planner', 'recorder',
+                               {'out_dir': self.out, **params})
 
     def start_node(self, name: str, package: str, executable: str, params=None,
                    ros_args=(), stream: bool = False) -> subprocess.Popen:
@@ -484,6 +503,11 @@ def parse_arguments(argv) -> argparse.Namespace:
                         help='stop the fleet and exit once the mission has ended')
     parser.add_argument('--timeout', type=_positive(float), metavar='S',
                         help='give up (exit 1) if the mission has not ended after S seconds')
+    parser.add_argument('--unauthenticated', action='store_true',
+                        help='run without a fleet key (by default a fresh one is written to '
+                             '<out>/fleet.key and given to every node; docs/security.md)')
+    parser.add_argument('--no-recording', action='store_true',
+                        help='do not record the mission topics to <out>/fjsp_<time>.mcap')
     return parser.parse_args(argv)
 
 
@@ -499,7 +523,8 @@ def run(args: argparse.Namespace) -> int:
     try:
         fleet = Fleet(args.scenario, panels=args.panels, time_scale=args.time_scale,
                       params_file=args.params_file, out=args.out,
-                      monitor={'exit_on_complete': True} if args.exit_on_complete else None)
+                      monitor={'exit_on_complete': True} if args.exit_on_complete else None,
+                      key=not args.unauthenticated)
     except FleetError as error:
         print(f'fleet: cannot run {args.scenario}:', file=sys.stderr)
         for problem in error.problems:
@@ -516,10 +541,13 @@ def run(args: argparse.Namespace) -> int:
     """The mission's exit code, once it has ended."""
     previous = {sig: signal.signal(sig, _stop_signal) for sig in (signal.SIGINT, signal.SIGTERM)}
     try:
-        fleet.start(stream_monitor=True)
+        fleet.start(stream_monitor=True, recorder=not args.no_recording)
         robots = ', '.join(r.name for r in fleet.problem.robots)
         print(f"fleet: scenario '{fleet.problem.name}' ({fleet.scenario}): planner, agents "
               f'of {robots} and monitor started; node logs in {fleet.logs}', flush=True)
+        if fleet.key_file is not None:
+            print(f'fleet: authenticated with the key in {fleet.key_file}; tools need it too: '
+                  f'export {KEY_FILE_VARIABLE}={fleet.key_file}', flush=True)
         return _watch(fleet, latest, ended, args)
     except _SignalError as stopped:
         if ended:

@@ -6,9 +6,10 @@ colcon workspace) writes under the ROS home directory instead, as ROS's own logs
 """
 
 import os
+import re
 from pathlib import Path
 
-from ament_index_python.packages import get_package_prefix
+from ament_index_python import packages
 
 PACKAGE = 'fjsp_planner'
 
@@ -17,7 +18,7 @@ def default_out_dir() -> Path:
     """`out/` of the colcon workspace fjsp_planner is installed in (the directory holding its
     install space, e.g. `ros2_ws/out`), else `$ROS_HOME/fjsp/out` (`~/.ros/fjsp/out`)."""
     try:
-        prefix = Path(get_package_prefix(PACKAGE)).resolve()
+        prefix = Path(packages.get_package_prefix(PACKAGE)).resolve()
     except (LookupError, OSError, ValueError):  # not installed, or AMENT_PREFIX_PATH unset
         prefix = None
     if prefix is not None:
@@ -32,6 +33,13 @@ def default_out_dir() -> Path:
 def installed_scenarios() -> Path | None:
     """The scenario files installed with the package (`share/fjsp_planner/scenarios`)."""
     try:
-        return Path(get_package_prefix(PACKAGE)) / 'share' / PACKAGE / 'scenarios'
+        return Path(packages.get_package_prefix(PACKAGE)) / 'share' / PACKAGE / 'scenarios'
     except (LookupError, OSError, ValueError):
         return None
+
+
+def safe_file_name(name: str, limit: int = 120) -> str:
+    """`name` usable as a file name: a mission id comes off the network and must not be able
+    to write outside the output directory."""
+    cleaned = re.sub(r'[^A-Za-z0-9_.-]', '_', name).lstrip('.')[:limit]
+    return cleaned or 'unnamed'

@@ -14,6 +14,7 @@ through `<robot_name>/inject_fault` (`fjsp_planner.faults`).
 import sys
 from collections import deque
 
+from diagnostic_msgs.msg import DiagnosticArray
 from rclpy.exceptions import InvalidServiceNameException
 from rclpy.node import Node
 from rclpy.time import Time as RosTime
@@ -32,8 +33,14 @@ from fjsp_common.contract import (
     ROBOT_STATES_TOPIC,
     TASK_EVENTS_TOPIC,
 )
+from fjsp_common.diagnostics import (
+    DIAGNOSTICS_QOS,
+    DIAGNOSTICS_TOPIC,
+    diagnostic_array,
+    robot_diagnostic,
+)
 from fjsp_common.running import ParameterError, declare, run_node, shorten
-from fjsp_common.vocabulary import EventKind
+from fjsp_common.vocabulary import EventKind, RobotMode
 from fjsp_msgs.msg import Plan, RobotState, TaskEvent
 from fjsp_msgs.srv import InjectFault
 from robot_agents.execution import FaultResult, RobotExecution, Task
@@ -61,6 +68,13 @@ class RobotAgent(Node):
         heartbeat_period = declare(self, 'heartbeat_period', 0.2,
                                    'seconds between robot states published as heartbeat',
                                    low=0.01, high=10.0)
+        diagnostics_period = declare(self, 'diagnostics_period', 1.0,
+                                     'seconds between health reports on /diagnostics',
+                                     low=0.1, high=60.0)
+        self.late_threshold = declare(
+            self, 'late_threshold', 2.0,
+            'schedule units an operation may run past its plan before the robot reports WARN',
+            low=0.0, high=1e6)
         if pinned_type and self.pinned_type != pinned_type:
             raise ParameterError(f"parameter 'robot_type': this executable plays a "
                                  f"'{pinned_type}', got '{self.pinned_type}' (use robot_agent "
@@ -95,8 +109,11 @@ class RobotAgent(Node):
         except InvalidServiceNameException:
             raise ParameterError(f"parameter 'robot_name' must be usable in a ROS name "
                                  f'(letters, digits, underscores), got {self.robot!r}') from None
+        self.diagnostics_pub = self.create_publisher(DiagnosticArray, DIAGNOSTICS_TOPIC,
+                                                     DIAGNOSTICS_QOS)
         self.create_timer(tick_period, self.tick)
         self.create_timer(heartbeat_period, self.publish_state)
+        self.create_timer(diagnostics_period, self.publish_diagnostics)
         self.publish_state()
         kind = f"a '{self.pinned_type}'" if self.pinned_type else 'any type'
         self.get_logger().info(f"robot '{self.robot}' ({kind}) ready, waiting for a plan")
@@ -311,6 +328,22 @@ class RobotAgent(Node):
             destination=execution.destination,
             progress=execution.progress(now) if now is not None else 0.0,
             busy_until=execution.busy_until), ROBOT_STATES_TOPIC))
+
+
+    def publish_diagnostics(self) -> None:
+        execution = self.execution
+        task = execution.task
+        late_by = 0.0
+        if task is not None and execution.mode == RobotMode.WORKING:
+            late_by = max(0.0, execution.busy_until - task.operation_end)
+        self.diagnostics_pub.publish(diagnostic_array(
+            self.get_clock().now().to_msg(),
+            [robot_diagnostic(f'{self.get_name()}: robot', self.robot, execution.mode,
+                              job=execution.current_job, late_by=late_by,
+                              late_threshold=self.late_threshold, refusal=self.refusal,
+                              values={'type': self.robot_type, 'mission': self.mission_id,
+                                      'plan revision': execution.revision,
+                                      'failures': self.failures})]))
 
 
 def agent_node_name(robot: str) -> str:

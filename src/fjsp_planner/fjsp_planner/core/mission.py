@@ -264,8 +264,7 @@ class MissionController:
         mission.problem = problem
         mission.tracker.extend(problem)
         reason = 'jobs added: ' + ', '.join(jobs)
-        effects: list[Effect] = [Note(MissionEventKind.JOBS_ADDED, (reason,),
-                                      job=', '.join(jobs))]
+        effects: list[Effect] = [Note(MissionEventKind.JOBS_ADDED, job=', '.join(jobs))]
         if mission.solving is not None:
             # Whatever is being solved leaves the new jobs out.
             mission.solving = None
@@ -353,6 +352,8 @@ class MissionController:
                                            report.current_job, at=self._now(mission, wall))
         if report.mode == RobotMode.FAILED and before != RobotMode.FAILED:
             effects.append(Note(MissionEventKind.ROBOT_FAILED, robot=report.robot))
+        elif before == RobotMode.FAILED and report.mode != RobotMode.FAILED:
+            effects.append(Note(MissionEventKind.ROBOT_BACK, ('recovered',), robot=report.robot))
         if report.refusal and report.refusal not in mission.warned:
             mission.warned.add(report.refusal)
             effects.append(Note(MissionEventKind.WARNING,
@@ -611,19 +612,20 @@ class MissionController:
         if replanned.problems:
             return self._block(mission, wall, tuple(f're-planned schedule is invalid: {p}'
                                                     for p in replanned.problems))
+        continued = frozenset(residual.problem.fixed)
         progressed = self._progressed(mission, solving.state, residual.problem)
-        if progressed:
+        if progressed and not self._goes_on(mission, result.schedule, progressed, continued):
             # Restarting these would redo work done meanwhile: plan again from now.
             mission.state = MissionState.EXECUTING
             mission.pending = solving.reasons
             return [Note(MissionEventKind.WARNING,
-                         ('re-plan discarded: ' + ', '.join(progressed)
+                         ('re-plan discarded: ' + ', '.join(f"job '{j}'" for j in progressed)
                           + ' progressed while it was solved',))]
         notes = [Note(MissionEventKind.JOB_VOIDED, ('its hold was lost',), job=job)
                  for job in residual.voided]
         mission.blocked, mission.blocked_since = (), None
         return notes + self._publish(mission, residual.problem, result,
-                                     frozenset(residual.problem.fixed), solving.reasons)
+                                     continued | frozenset(progressed), solving.reasons)
 
     def _progressed(self, mission, posed_state: ExecutionState, posed: Problem) -> list[str]:
         """Jobs the new plan starts afresh that started or completed since it was posed."""
@@ -635,8 +637,27 @@ class MissionController:
             record = tracker.jobs[job.name]
             started_before = job.name in posed_state.running or job.name in posed_state.done
             if (record.end is not None or record.started) and not started_before:
-                moved.append(f"job '{job.name}'")
+                moved.append(job.name)
         return moved
+
+    def _goes_on(self, mission, schedule: Schedule, progressed, continued) -> bool:
+        """Whether the new plan can let the jobs that progressed while it was solved go on
+        as they are (continued, not redone): it gives each the plan and robots it runs with,
+        and each of those robots does them first, in the order it began them, before any
+        job the plan starts afresh — so every robot's next leg leaves from where it is."""
+        tracker = mission.tracker
+        order = sorted(progressed, key=lambda job: tracker.jobs[job].start)
+        for job in order:
+            running, new = tracker.plan.jobs[job], schedule.jobs.get(job)
+            if new is None or new.plan != running.plan \
+                    or dict(new.robots) != dict(running.robots):
+                return False
+        for robot in {r for job in order for r in tracker.plan.jobs[job].robots}:
+            mine = [job for job in order if robot in tracker.plan.jobs[job].robots]
+            fresh = [job for job in schedule.sequences.get(robot, ()) if job not in continued]
+            if fresh[:len(mine)] != mine:
+                return False
+        return True
 
     def _publish(self, mission, posed, result, continued, reasons) -> list[Effect]:
         tracker = mission.tracker

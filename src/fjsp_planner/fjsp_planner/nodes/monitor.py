@@ -1,220 +1,270 @@
-"""A fleet-level mission monitor built only on the public topics.
+"""The fleet's mission monitor, built only on the public topics.
 
-It shows one line per robot and a mission line while the mission runs (a robot whose
-heartbeat is lost shows as offline) and, once it is complete, logs a summary and draws the
-planned and executed timelines into a PNG. Everything it needs is latched (plan, states,
-status) or kept for late joiners (task events), so it can be started at any time, even after
-the mission ended.
+It keeps the whole history of every mission it sees (`fjsp_planner.observe`) and shows it
+three ways: in its log, a line per event (faults, re-plans with their reasons, aborted and
+voided jobs, robots offline and back) and a frame of the mission whenever something changed;
+on a live web page (`web_port`); and, once a mission ended, as a summary and a Gantt chart of
+the whole mission in `out_dir`. It also publishes each robot's health on `/diagnostics` as
+the fleet sees it, which is how a robot whose agent died shows up there.
+
+Everything it reads is latched (plan, robot states, status) or kept for late joiners (task
+and mission events), so it can be started at any time, even after a mission ended.
 """
 
-import math
 import sys
+import time
 from pathlib import Path
 
-import rclpy
+from diagnostic_msgs.msg import DiagnosticArray
 from rclpy.node import Node
-from rclpy.time import Time
 
+from fjsp_common.auth import PLANNER, NodeAuth
 from fjsp_common.contract import (
     EVENTS_QOS,
     LATCHED_QOS,
+    MISSION_EVENTS_TOPIC,
     MISSION_STATUS_TOPIC,
-    MODE_FROM_MSG,
     PLAN_TOPIC,
     ROBOT_STATES_QOS,
     ROBOT_STATES_TOPIC,
-    STATE_FROM_MSG,
     TASK_EVENTS_TOPIC,
 )
-from fjsp_common.running import declare, run_node
-from fjsp_msgs.msg import MissionStatus, Plan, RobotState, TaskEvent
+from fjsp_common.diagnostics import (
+    DIAGNOSTICS_QOS,
+    DIAGNOSTICS_TOPIC,
+    diagnostic_array,
+    robot_diagnostic,
+)
+from fjsp_common.running import declare, run_node, shorten
+from fjsp_common.vocabulary import RobotMode
+from fjsp_msgs.msg import MissionEvent, MissionStatus, Plan, RobotState, TaskEvent
+from fjsp_planner.observe import text, views
+from fjsp_planner.observe.dashboard import Dashboard
+from fjsp_planner.observe.facts import Decoder, UnreadableMessageError
+from fjsp_planner.observe.gantt import write_mission
+from fjsp_planner.observe.history import FleetHistory, MissionHistory, Outcome
+from fjsp_planner.workspace import default_out_dir, safe_file_name
+
+DECODER = Decoder.from_classes(RobotState, TaskEvent, MissionStatus, MissionEvent)
+TIMELINE_PERIOD = 1.0
+"""Seconds between page updates when only the clock moved (offline robots, the timeline)."""
+
+
+def senders_of(msg) -> set[str]:
+    """Who may have signed `msg`: the robot it is about, or the planner."""
+    if isinstance(msg, RobotState):
+        return {msg.robot}
+    if isinstance(msg, TaskEvent) and msg.kind != TaskEvent.KIND_JOB_DONE:
+        return {msg.robot}
+    return {PLANNER}
 
 
 class MonitorNode(Node):
     def __init__(self):
         super().__init__('monitor')
-        self.gantt_dir = Path(declare(self, 'gantt_dir', '.',
-                                      'directory the Gantt charts are written to')).expanduser()
+        out_dir = declare(self, 'out_dir', '',
+                          "directory of the Gantt charts and histories; empty: the workspace's "
+                          'out/ (else ~/.ros/fjsp/out)')
+        self.out_dir = Path(out_dir).expanduser() if out_dir else default_out_dir()
         refresh_period = declare(self, 'refresh_period', 1.0,
-                                 'seconds between refreshes of the view', low=0.05, high=60.0)
-        self.heartbeat_timeout = declare(
+                                 'seconds between checks for a new frame of the log view',
+                                 low=0.05, high=60.0)
+        heartbeat_timeout = declare(
             self, 'heartbeat_timeout', 1.0,
             'seconds without a robot state before the robot shows offline', low=0.05,
             high=600.0)
         self.exit_on_complete = declare(self, 'exit_on_complete', False,
-                                        'exit once the mission is complete and drawn')
-        # Events may reach a late joiner after the status saying the mission is complete.
+                                        'exit once a mission has ended and is drawn')
+        # Events may reach a late joiner after the status saying the mission ended.
         self.event_grace = declare(
             self, 'event_grace', 3.0,
-            'seconds to wait for late task events once the mission is complete', low=0.0,
-            high=600.0)
-        self.plan: Plan | None = None
-        self.status: MissionStatus | None = None
-        self.robots: dict[str, RobotState] = {}
-        self.heard: dict[str, Time] = {}
-        """When each robot's latest state was received."""
-        self.started: dict[tuple[str, str], float] = {}
-        self.job_done: dict[str, float] = {}
-        self.event_ids: set[str] = set()
-        self.shown = None
-        self.complete_since = None
-        self.reported: set[tuple] = set()
+            'seconds to wait for late events once a mission ended before drawing it',
+            low=0.0, high=600.0)
+        web_port = declare(self, 'web_port', 8080,
+                           'port of the live web page; 0: no web page', low=0, high=65535)
+        web_host = declare(self, 'web_host', '127.0.0.1',
+                           'address the web page is served on (0.0.0.0: every interface)')
+        web_period = declare(self, 'web_period', 0.1,
+                             'seconds between checks for changes to push to the web page',
+                             low=0.02, high=10.0)
+        diagnostics_period = declare(
+            self, 'diagnostics_period', 1.0,
+            'seconds between per-robot diagnostics on /diagnostics', low=0.1, high=60.0)
+        self.late_threshold = declare(
+            self, 'late_threshold', 2.0,
+            "schedule units a robot's operation may run past its plan before its diagnostic "
+            'is WARN', low=0.0, high=1e6)
+
+        self.fleet = FleetHistory(heartbeat_timeout)
+        self.told: set[tuple[str, str]] = set()
+        """(mission, story key) of every line already logged."""
+        self.frame_key = None
+        self.ended_since: dict[str, float] = {}
+        self.drawn: set[str] = set()
+        self.unreadable: set[str] = set()
         self.finished = False
+        self.pushed_version = (-1, 0.0)
+        self.pushed_timeline = (None, -1, 0.0)
 
-        self.create_subscription(Plan, PLAN_TOPIC, self.on_plan, LATCHED_QOS)
-        self.create_subscription(RobotState, ROBOT_STATES_TOPIC, self.on_robot,
-                                 ROBOT_STATES_QOS)
-        self.create_subscription(MissionStatus, MISSION_STATUS_TOPIC, self.on_status,
-                                 LATCHED_QOS)
-        self.create_subscription(TaskEvent, TASK_EVENTS_TOPIC, self.on_event, EVENTS_QOS)
+        self.dashboard = None
+        if web_port:
+            try:
+                self.dashboard = Dashboard(web_host, web_port)
+                self.get_logger().info(f'live mission page: {self.dashboard.url}')
+            except OSError as error:
+                self.get_logger().error(
+                    f'no live web page: cannot serve on {web_host}:{web_port} '
+                    f'({error.strerror or error}); set web_port to a free port, or 0')
+
+        self.auth = NodeAuth(self, 'monitor')
+        for msg_type, topic, qos in ((Plan, PLAN_TOPIC, LATCHED_QOS),
+                                     (RobotState, ROBOT_STATES_TOPIC, ROBOT_STATES_QOS),
+                                     (TaskEvent, TASK_EVENTS_TOPIC, EVENTS_QOS),
+                                     (MissionEvent, MISSION_EVENTS_TOPIC, EVENTS_QOS),
+                                     (MissionStatus, MISSION_STATUS_TOPIC, LATCHED_QOS)):
+            self.create_subscription(msg_type, topic, self.receiver(msg_type.__name__, topic),
+                                     qos)
+        self.diagnostics_pub = self.create_publisher(DiagnosticArray, DIAGNOSTICS_TOPIC,
+                                                     DIAGNOSTICS_QOS)
         self.create_timer(refresh_period, self.refresh)
+        self.create_timer(diagnostics_period, self.publish_diagnostics)
+        if self.dashboard is not None:
+            self.create_timer(web_period, self.push_page)
 
-    def on_plan(self, msg: Plan) -> None:
-        if self.plan is None or msg.revision > self.plan.revision:
-            self.plan = msg
+    def receiver(self, type_name: str, topic: str):
+        def receive(msg) -> None:
+            if not self.auth.accept(msg, topic, senders_of(msg)):
+                return
+            try:
+                fact = DECODER.read(type_name, msg)
+            except UnreadableMessageError as error:
+                if type_name not in self.unreadable:
+                    self.unreadable.add(type_name)
+                    self.get_logger().warning(f'ignoring {type_name} messages it cannot read '
+                                              f'(logged once): {shorten(str(error))}')
+                return
+            self.fleet.add(fact)
+        return receive
 
-    def on_robot(self, msg: RobotState) -> None:
-        self.robots[msg.robot] = msg
-        self.heard[msg.robot] = self.get_clock().now()
-
-    def on_status(self, msg: MissionStatus) -> None:
-        self.status = msg
-
-    def on_event(self, msg: TaskEvent) -> None:
-        if msg.event_id in self.event_ids:
-            return
-        self.event_ids.add(msg.event_id)
-        if msg.kind == TaskEvent.KIND_STARTED:
-            self.started[msg.robot, msg.job] = msg.time
-        elif msg.kind == TaskEvent.KIND_JOB_DONE:
-            self.job_done[msg.job] = msg.time
-        elif msg.kind == TaskEvent.KIND_ABORTED:
-            self.started.pop((msg.robot, msg.job), None)
-
-    # --- the live view ---------------------------------------------------------------
-
-    def view(self) -> str:
-        lines = []
-        s = self.status
-        if s is None:
-            lines.append('mission: no status yet (is the planner running?)')
-        else:
-            lines.append(
-                f'mission {s.scenario_id} rev {s.plan_revision}: '
-                f'{STATE_FROM_MSG.get(s.state, s.state)}, {s.jobs_done}/{s.jobs_total} jobs '
-                f'done, {s.jobs_running} running, makespan planned {s.planned_makespan:.2f} '
-                f'projected {s.projected_makespan:.2f}, t={s.elapsed:.1f}'
-                + (f', ignored {s.ignored_stale} stale / {s.ignored_duplicate} duplicate / '
-                   f'{s.ignored_unknown} unknown'
-                   if s.ignored_stale + s.ignored_duplicate + s.ignored_unknown else ''))
-            lines += [f'  blocked: {reason}' for reason in s.blocked_reasons]
-        names = [r.robot for r in self.plan.robots] if self.plan else []
-        names += sorted(set(self.robots) - set(names))
-        now = self.get_clock().now()
-        for name in names:
-            r = self.robots.get(name)
-            if r is None:
-                lines.append(f'  {name:<10} no report')
-                continue
-            silent = (now - self.heard[name]).nanoseconds * 1e-9
-            if silent > self.heartbeat_timeout:
-                mode = 'offline'
-            else:
-                mode = MODE_FROM_MSG.get(r.mode, f'mode {r.mode}')
-            where = (f'{r.location or "?"} -> {r.destination}' if r.destination
-                     else r.location or '-')
-            lines.append(f'  {name:<10} {mode:<10} job {r.current_job or "-":<4} '
-                         f'{r.progress:4.0%}  at {where}')
-        return '\n'.join(lines)
+    # --- the log ---------------------------------------------------------------------
 
     def refresh(self) -> None:
-        view = self.view()
-        if view != self.shown:
-            self.shown = view
-            self.get_logger().info('\n' + view)
-        self.check_complete()
-
-    # --- the end of a mission --------------------------------------------------------
-
-    def check_complete(self) -> None:
-        s, plan = self.status, self.plan
-        if s is None or plan is None or s.state != MissionStatus.STATE_COMPLETE \
-                or s.plan_revision != plan.revision:
-            self.complete_since = None
-            return
-        key = (s.scenario_id, plan.mission_start.sec, plan.mission_start.nanosec,
-               plan.revision)
-        if key in self.reported:
-            return
-        jobs = {t.job for r in plan.robots for t in r.tasks}
-        now = self.get_clock().now()
-        if self.complete_since is None:
-            self.complete_since = now
-        waited = (now - self.complete_since).nanoseconds * 1e-9
-        if not jobs <= set(self.job_done) and waited < self.event_grace:
-            return
-        self.reported.add(key)
-        path = self.gantt_dir / (f'{s.scenario_id}_{plan.mission_start.sec}_'
-                                 f'r{plan.revision}.png')
+        now = time.time()
         log = self.get_logger()
+        for mission in self.missions_by_start():
+            for item in views.story(self.fleet, mission, now):
+                if (mission.mission_id, item['key']) not in self.told:
+                    self.told.add((mission.mission_id, item['key']))
+                    log.info(text.story_line(item))
+        current = self.fleet.current()
+        shown, key = text.frame(views.header(current, now) if current is not None else None,
+                                views.robot_rows(self.fleet, current, now))
+        if key != self.frame_key:
+            self.frame_key = key
+            log.info('\n' + shown)
+        self.draw_ended(now)
+
+    def missions_by_start(self) -> list[MissionHistory]:
+        return sorted(self.fleet.missions.values(), key=lambda m: m.last_stamp)
+
+    def draw_ended(self, now: float) -> None:
+        """Summarise and draw each mission once it ended and its last events came in."""
+        for mission in list(self.fleet.missions.values()):
+            if not mission.ended or mission.mission_id in self.drawn:
+                continue
+            since = self.ended_since.setdefault(mission.mission_id, now)
+            if not mission.agrees_with_status() and now - since < self.event_grace:
+                continue
+            self.drawn.add(mission.mission_id)
+            self.report(mission, now)
+            if self.exit_on_complete:
+                self.finished = True
+
+    def report(self, mission: MissionHistory, now: float) -> None:
+        """Log the summary; write the Gantt chart and the history (JSON) to out_dir."""
+        log = self.get_logger()
+        path = self.out_dir / f'{safe_file_name(mission.mission_id)}.png'
         try:
-            draw(plan, self.started, self.job_done, path)
-            where = f'Gantt chart: {path.resolve()}'
+            write_mission(self.fleet, mission, now, path)
+            where = f'Gantt chart: {path}'
         except OSError as error:
-            where = f'could not write the Gantt chart {path}: {error.strerror}'
-            log.error(where)
-        executed = max(self.job_done.values(), default=math.nan)
-        log.info(f'mission {s.scenario_id} complete: {len(jobs & set(self.job_done))}/'
-                 f'{len(jobs)} jobs done; makespan planned {plan.makespan:.2f}, executed '
-                 f'{executed:.2f} schedule units; {where}')
-        if self.exit_on_complete:
-            self.finished = True
+            where = f'could not write the Gantt chart {path}: {error.strerror or error}'
+        log.info(text.summary(mission) + f'; {where}')
 
+    # --- the web page ----------------------------------------------------------------
 
-def draw(plan: Plan, started, job_done, path: Path) -> None:
-    """Planned (upper, light) and executed (lower, solid) bars per robot, travel as lines."""
-    import matplotlib
+    def push_page(self) -> None:
+        """Send the page what changed since the last push."""
+        now = time.time()
+        version, at = self.pushed_version
+        if self.fleet.version == version and now - at < TIMELINE_PERIOD:
+            return
+        self.pushed_version = (self.fleet.version, now)
+        current = self.fleet.current()
+        parts = {'missions': views.missions(self.fleet)}
+        parts['robots'] = views.robot_rows(self.fleet, current, now)
+        if current is None:
+            parts['mission'] = {'mission_id': '', 'scenario': '', 'state': 'no mission yet',
+                                'planner': views.planner_state(self.fleet)}
+        else:
+            header = views.header(current, now)
+            header['planner'] = views.planner_state(self.fleet)
+            parts['mission'] = header
+            parts['story'] = views.story(self.fleet, current, now)
+            # The timeline is the largest part: rebuilt when the mission's facts changed, else
+            # only as often as its clock needs.
+            mission_id, version, at = self.pushed_timeline
+            if (mission_id, version) != (current.mission_id, current.version) \
+                    or now - at >= TIMELINE_PERIOD:
+                self.pushed_timeline = (current.mission_id, current.version, now)
+                parts['timeline'] = views.timeline(self.fleet, current, now)
+        self.dashboard.publish(parts)
 
-    matplotlib.use('Agg')
-    import matplotlib.pyplot as plt
+    # --- diagnostics -----------------------------------------------------------------
 
-    robots = [r.robot for r in plan.robots]
-    fig, ax = plt.subplots(figsize=(11, 1.0 + 0.8 * len(robots)))
-    colours = plt.get_cmap('tab20')
-    jobs = sorted({t.job for r in plan.robots for t in r.tasks})
-    colour = {job: colours(i % 20) for i, job in enumerate(jobs)}
-    for y, robot_plan in enumerate(plan.robots):
-        for t in robot_plan.tasks:
-            if t.arrival > t.travel_start:
-                ax.plot([t.travel_start, t.arrival], [y - 0.2, y - 0.2], color='grey', lw=1)
-            ax.barh(y - 0.2, t.end - t.start, left=t.start, height=0.35,
-                    color=colour[t.job], alpha=0.45, edgecolor='black', hatch='//')
-            ax.text((t.start + t.end) / 2, y - 0.2, t.job, ha='center', va='center',
-                    fontsize=7)
-            begin = started.get((robot_plan.robot, t.job))
-            end = job_done.get(t.job)
-            if begin is not None and end is not None:
-                ax.barh(y + 0.2, end - begin, left=begin, height=0.35, color=colour[t.job],
-                        edgecolor='black')
-                ax.text((begin + end) / 2, y + 0.2, t.job, ha='center', va='center',
-                        fontsize=7)
-    ax.set_yticks(range(len(robots)), robots)
-    ax.invert_yaxis()  # first robot on top; within a row, planned above executed
-    ax.set_xlabel('schedule time units (upper bar: planned, lower bar: executed)')
-    executed = max(job_done.values(), default=math.nan)
-    ax.set_title(f'{plan.scenario_id}, plan revision {plan.revision}: planned makespan '
-                 f'{plan.makespan:.2f}, executed {executed:.2f}')
-    ax.grid(axis='x', alpha=0.3)
-    fig.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    def publish_diagnostics(self) -> None:
+        current = self.fleet.current()
+        if current is None:
+            return
+        now = time.time()
+        silent = self.fleet.silent(current, now)
+        statuses = []
+        for robot in current.robot_names():
+            state = self.fleet.robots.get(robot)
+            statuses.append(robot_diagnostic(
+                f'{self.get_name()}: robot {robot}', robot,
+                state.mode if state is not None else None,
+                job=state.current_job if state is not None else '',
+                late_by=self.lateness(current, state) if state is not None else 0.0,
+                late_threshold=self.late_threshold,
+                refusal=state.refusal if state is not None else '',
+                silent_for=now - silent[robot] if robot in silent else None,
+                values={'mission': current.mission_id,
+                        'plan revision': state.revision if state is not None else 0,
+                        'location': state.location if state is not None else ''}))
+        self.diagnostics_pub.publish(diagnostic_array(self.get_clock().now().to_msg(),
+                                                      statuses))
 
+    @staticmethod
+    def lateness(mission: MissionHistory, state) -> float:
+        """Schedule units a working robot expects to end after its plan said (0 if not)."""
+        if state.mode != RobotMode.WORKING or not state.current_job:
+            return 0.0
+        task = next((t for t in mission.tasks_of(state.revision, state.current_job)
+                     if t.robot == state.robot), None)
+        attempt = mission.latest_attempts().get(state.current_job)
+        if task is None or attempt is None or attempt.outcome != Outcome.RUNNING:
+            return 0.0
+        started = attempt.started.get(state.robot, task.start)
+        planned = max(task.operation_end, started + task.operation_end - task.start)
+        late = state.busy_until - planned
+        return late if late > 0 else 0.0
 
-def spin_until_finished(node: 'MonitorNode') -> None:
-    while rclpy.ok() and not node.finished:
-        rclpy.spin_once(node, timeout_sec=0.2)
+    def destroy_node(self):
+        if self.dashboard is not None:
+            self.dashboard.close()
+        return super().destroy_node()
 
 
 def main(args=None):
-    sys.exit(run_node(MonitorNode, 'monitor', args, spin=spin_until_finished))
+    sys.exit(run_node(MonitorNode, 'monitor', args, done=lambda node: node.finished))

@@ -11,10 +11,12 @@ import hashlib
 import math
 import secrets
 import sys
+import time
 from concurrent.futures import Future, ThreadPoolExecutor
 from datetime import UTC, datetime
 from pathlib import Path
 
+from diagnostic_msgs.msg import DiagnosticArray
 from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.node import Node
 from rclpy.task import Future as RosFuture
@@ -38,6 +40,12 @@ from fjsp_common.contract import (
     RUN_MISSION_ACTION,
     STATE_TO_MSG,
     TASK_EVENTS_TOPIC,
+)
+from fjsp_common.diagnostics import (
+    DIAGNOSTICS_QOS,
+    DIAGNOSTICS_TOPIC,
+    diagnostic_array,
+    planner_diagnostic,
 )
 from fjsp_common.running import ParameterError, declare, run_node, shorten
 from fjsp_common.vocabulary import MissionEventKind, MissionState
@@ -124,7 +132,7 @@ def describe(note: Note) -> str:
     """One log line: "robot 'MARC1' offline: no state for 1.2 s", "plan published: ..."."""
     subject = SUBJECTS.get(note.kind)
     if subject is None:
-        text = str(note.kind)
+        text = str(note.kind) + (f': {note.job}' if note.job else '')
     else:
         text = f"{subject[0]} '{note.robot if subject[0] == 'robot' else note.job}' {subject[1]}"
     return text + (': ' + '; '.join(note.reasons) if note.reasons else '')
@@ -189,6 +197,11 @@ class PlannerNode(Node):
         self.journal: Journal | None = None
         self.goal: Goal | None = None
         self.job_done_ids: set[str] = set()
+        self.solver_answer: tuple[str, float | None] = ('', None)
+        """Status and gap of the latest plan's solve."""
+        self.replan_began: float | None = None
+        self.replan_latency: float | None = None
+        """Seconds from the decision to re-plan to the new revision's publication."""
         self.last_published = None
         """(mission, revision, stamp) of this node's latest plan, which it hears back."""
         self.event_count = 0
@@ -208,8 +221,11 @@ class PlannerNode(Node):
         self.events_sub = self.create_subscription(TaskEvent, TASK_EVENTS_TOPIC, self.on_event,
                                                    EVENTS_QOS)
         self.create_subscription(Plan, PLAN_TOPIC, self.on_plan, LATCHED_QOS)
+        self.diagnostics_pub = self.create_publisher(DiagnosticArray, DIAGNOSTICS_TOPIC,
+                                                     DIAGNOSTICS_QOS)
         self.create_timer(0.1, self.tick)
         self.create_timer(status_period, self.publish_periodic)
+        self.create_timer(1.0, self.publish_diagnostics)
         ActionServer(self, RunMission, RUN_MISSION_ACTION, self.execute_goal,
                      goal_callback=lambda _: GoalResponse.ACCEPT,
                      cancel_callback=self.cancel_goal)
@@ -559,6 +575,7 @@ class PlannerNode(Node):
             future = self.pool.submit(solve, request.problem, solver=self.solver,
                                       time_limit=request.time_limit, workers=workers)
         else:
+            self.replan_began = time.monotonic()
             now = self.controller.now_units(self.wall())
             self.get_logger().warning(f're-planning at t={now:.2f}: '
                                       + shorten('; '.join(request.reasons), 2000))
@@ -630,6 +647,9 @@ class PlannerNode(Node):
             log.warning(f'published plan revision {effect.revision}: mission cancelled')
             return
         result = effect.result
+        self.solver_answer = (str(result.status), result.gap)
+        if effect.revision > 1 and self.replan_began is not None:
+            self.replan_latency, self.replan_began = time.monotonic() - self.replan_began, None
         gap = f', gap {result.gap:.1%}' if result.gap is not None else ''
         now = self.controller.now_units(self.wall())
         log.info(f'published plan revision {effect.revision}: makespan '
@@ -669,6 +689,20 @@ class PlannerNode(Node):
             time=max(self.controller.now_units(wall), 0.0), robot=note.robot, job=note.job,
             reasons=list(note.reasons)), MISSION_EVENTS_TOPIC))
         self.get_logger().info(shorten(describe(note), 2000))
+
+    def publish_diagnostics(self) -> None:
+        view = self.controller.status(self.wall())
+        if view is None:
+            return
+        status, gap = self.solver_answer
+        self.diagnostics_pub.publish(diagnostic_array(
+            self.get_clock().now().to_msg(),
+            [planner_diagnostic(f'{self.get_name()}: mission', view.state,
+                                mission_id=view.mission_id, revision=view.revision,
+                                jobs_done=view.jobs_done, jobs_total=view.jobs_total,
+                                solver_status=status, gap=gap,
+                                replan_latency=self.replan_latency,
+                                blocked_reasons=view.blocked, warnings=view.warnings)]))
 
     def publish_periodic(self) -> None:
         self.publish_status()

@@ -1,0 +1,247 @@
+"""The fleet's messages as plain, immutable facts, read from anything shaped like them.
+
+A live rclpy message and a message decoded from a recording by `mcap_ros2` have the same field
+names but not the same classes, and only the live one carries the message constants. A
+`Decoder` reads both: it is built from the constants of the message classes (live) or from the
+message definitions stored in the recording (replay), and pairs each constant with the
+vocabulary word of the same name, as `fjsp_common.contract` does for the nodes. Numbers the
+decoder does not know (a newer fleet, a forged message) raise `UnreadableMessageError` instead
+of being guessed.
+"""
+
+import re
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+from fjsp_common.vocabulary import EventKind, MissionEventKind, MissionState, RobotMode
+
+VOCABULARIES = {
+    'RobotState': ('MODE', RobotMode),
+    'TaskEvent': ('KIND', EventKind),
+    'MissionStatus': ('STATE', MissionState),
+    'MissionEvent': ('KIND', MissionEventKind),
+}
+"""Message type -> (prefix of its constants, the vocabulary they name)."""
+
+
+class UnreadableMessageError(ValueError):
+    """A message with a value this decoder cannot name."""
+
+
+@dataclass(frozen=True)
+class PlannedTask:
+    """One robot's part in one job of a plan revision (schedule units)."""
+
+    robot: str
+    job: str
+    operation: str
+    location: str
+    travel_start: float
+    arrival: float
+    start: float
+    operation_end: float
+    end: float
+    co_workers: tuple[str, ...]
+    predecessors: tuple[str, ...]
+    held_into_next: bool
+    continued: bool
+
+
+@dataclass(frozen=True)
+class PlanFact:
+    stamp: float
+    """Wall time of publication, seconds since the epoch (as every stamp here)."""
+    mission_id: str
+    revision: int
+    scenario_id: str
+    mission_start: float
+    time_scale: float
+    cancelled: bool
+    makespan: float
+    solver_status: str
+    lower_bound: float
+    reasons: tuple[str, ...]
+    robots: tuple[tuple[str, str], ...]
+    """(robot, robot type) of every robot of the scenario, in the plan's order."""
+    tasks: tuple[PlannedTask, ...]
+
+
+@dataclass(frozen=True)
+class TaskEventFact:
+    stamp: float
+    event_id: str
+    mission_id: str
+    kind: EventKind
+    robot: str
+    job: str
+    revision: int
+    time: float
+    reason: str
+
+
+@dataclass(frozen=True)
+class MissionEventFact:
+    stamp: float
+    event_id: str
+    mission_id: str
+    kind: MissionEventKind
+    revision: int
+    time: float
+    robot: str
+    job: str
+    reasons: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class RobotStateFact:
+    stamp: float
+    robot: str
+    robot_type: str
+    incarnation: int
+    mission_id: str
+    mode: RobotMode
+    revision: int
+    refusal: str
+    failures: int
+    current_job: str
+    location: str
+    destination: str
+    progress: float
+    busy_until: float
+
+
+@dataclass(frozen=True)
+class StatusFact:
+    stamp: float
+    mission_id: str
+    state: MissionState
+    revision: int
+    scenario_id: str
+    jobs_done: int
+    jobs_running: int
+    jobs_total: int
+    planned_makespan: float
+    projected_makespan: float
+    elapsed: float
+    blocked_reasons: tuple[str, ...]
+    replan_reasons: tuple[str, ...]
+    warnings: tuple[str, ...]
+    ignored: tuple[int, int, int]
+    """Messages the planner ignored as stale, duplicate, unknown."""
+
+
+Fact = PlanFact | TaskEventFact | MissionEventFact | RobotStateFact | StatusFact
+
+_CONSTANT = re.compile(r'^\s*(?:u?int(?:8|16|32|64)|byte|char)\s+([A-Z][A-Z0-9_]*)\s*=\s*(-?\d+)',
+                       re.MULTILINE)
+_SECTION = re.compile(r'^={3,}\s*$', re.MULTILINE)
+_SECTION_NAME = re.compile(r'^MSG:\s*(\S+)\s*$', re.MULTILINE)
+
+
+def seconds(stamp) -> float:
+    """A `builtin_interfaces/Time` as seconds since the epoch."""
+    return stamp.sec + stamp.nanosec * 1e-9
+
+
+def short_type(type_name: str) -> str:
+    """'fjsp_msgs/msg/Plan' (or 'fjsp_msgs/Plan') -> 'Plan'."""
+    return type_name.rsplit('/', 1)[-1]
+
+
+class Decoder:
+    """Turns message-shaped objects into facts, given what each message constant means."""
+
+    def __init__(self, constants: Mapping[str, Mapping[str, int]]):
+        """`constants`: message type ('RobotState') -> {constant name: value}."""
+        self._words = {}
+        for type_name, (prefix, vocabulary) in VOCABULARIES.items():
+            table = constants.get(type_name, {})
+            self._words[type_name] = {table[f'{prefix}_{word.name}']: word
+                                      for word in vocabulary
+                                      if f'{prefix}_{word.name}' in table}
+
+    @classmethod
+    def from_classes(cls, *classes) -> 'Decoder':
+        """From message classes that carry their constants as attributes (rclpy's)."""
+        return cls({c.__name__: {name: getattr(c, name) for name in dir(c)
+                                 if name.isupper() and not name.startswith('_')}
+                    for c in classes})
+
+    @classmethod
+    def from_definitions(cls, definitions: Mapping[str, str]) -> 'Decoder':
+        """From ROS 2 message definitions (`ros2msg` text, as a recording stores them),
+        keyed by type name; constants of the nested definitions are read too."""
+        constants: dict[str, dict[str, int]] = {}
+        for type_name, text in definitions.items():
+            for section in _SECTION.split(text):
+                named = _SECTION_NAME.search(section)
+                name = short_type(named.group(1) if named else type_name)
+                constants.setdefault(name, {}).update(
+                    (m.group(1), int(m.group(2))) for m in _CONSTANT.finditer(section))
+        return cls(constants)
+
+    def _word(self, type_name: str, value: int):
+        try:
+            return self._words[type_name][value]
+        except KeyError:
+            raise UnreadableMessageError(f'{type_name} value {value} has no known meaning'
+                                         ) from None
+
+    def read(self, type_name: str, msg) -> Fact | None:
+        """The fact `msg` (a message of type `type_name`) states, or None for a type the
+        history does not use."""
+        reader = {'Plan': self.plan, 'TaskEvent': self.task_event,
+                  'MissionEvent': self.mission_event, 'RobotState': self.robot_state,
+                  'MissionStatus': self.status}.get(short_type(type_name))
+        return reader(msg) if reader else None
+
+    def plan(self, msg) -> PlanFact:
+        tasks = tuple(
+            PlannedTask(robot=r.robot, job=t.job, operation=t.operation_name,
+                        location=t.location, travel_start=t.travel_start, arrival=t.arrival,
+                        start=t.start, operation_end=t.operation_end, end=t.end,
+                        co_workers=tuple(t.co_workers), predecessors=tuple(t.predecessors),
+                        held_into_next=bool(t.held_into_next), continued=bool(t.continued))
+            for r in msg.robots for t in r.tasks)
+        return PlanFact(stamp=seconds(msg.stamp), mission_id=msg.mission_id,
+                        revision=msg.revision, scenario_id=msg.scenario_id,
+                        mission_start=seconds(msg.mission_start), time_scale=msg.time_scale,
+                        cancelled=bool(msg.cancelled), makespan=msg.makespan,
+                        solver_status=msg.solver_status, lower_bound=msg.lower_bound,
+                        reasons=tuple(msg.reasons),
+                        robots=tuple((r.robot, r.robot_type) for r in msg.robots), tasks=tasks)
+
+    def task_event(self, msg) -> TaskEventFact:
+        return TaskEventFact(stamp=seconds(msg.stamp), event_id=msg.event_id,
+                             mission_id=msg.mission_id, kind=self._word('TaskEvent', msg.kind),
+                             robot=msg.robot, job=msg.job, revision=msg.plan_revision,
+                             time=msg.time, reason=msg.reason)
+
+    def mission_event(self, msg) -> MissionEventFact:
+        return MissionEventFact(stamp=seconds(msg.stamp), event_id=msg.event_id,
+                                mission_id=msg.mission_id,
+                                kind=self._word('MissionEvent', msg.kind),
+                                revision=msg.plan_revision, time=msg.time, robot=msg.robot,
+                                job=msg.job, reasons=tuple(msg.reasons))
+
+    def robot_state(self, msg) -> RobotStateFact:
+        return RobotStateFact(stamp=seconds(msg.stamp), robot=msg.robot,
+                              robot_type=msg.robot_type, incarnation=msg.incarnation,
+                              mission_id=msg.mission_id, mode=self._word('RobotState', msg.mode),
+                              revision=msg.plan_revision, refusal=msg.refusal,
+                              failures=msg.failures, current_job=msg.current_job,
+                              location=msg.location, destination=msg.destination,
+                              progress=msg.progress, busy_until=msg.busy_until)
+
+    def status(self, msg) -> StatusFact:
+        return StatusFact(stamp=seconds(msg.stamp), mission_id=msg.mission_id,
+                          state=self._word('MissionStatus', msg.state),
+                          revision=msg.plan_revision, scenario_id=msg.scenario_id,
+                          jobs_done=msg.jobs_done, jobs_running=msg.jobs_running,
+                          jobs_total=msg.jobs_total, planned_makespan=msg.planned_makespan,
+                          projected_makespan=msg.projected_makespan, elapsed=msg.elapsed,
+                          blocked_reasons=tuple(msg.blocked_reasons),
+                          replan_reasons=tuple(msg.replan_reasons),
+                          warnings=tuple(msg.warnings),
+                          ignored=(msg.ignored_stale, msg.ignored_duplicate,
+                                   msg.ignored_unknown))

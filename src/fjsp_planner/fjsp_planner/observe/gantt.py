@@ -1,0 +1,185 @@
+"""The Gantt chart of a whole mission: one row per robot, with what was planned (the first
+and the latest revision), the work done in every attempt (aborted and voided ones marked),
+travel, waiting and holds, failed and offline spans, and a line where each revision was
+published with the reasons listed under the chart.
+
+It draws `views.timeline` data, the same the web page draws, so the PNG written at the end of
+a mission (or by `replay`) and the live page show one picture.
+"""
+
+import json
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use('Agg')
+import matplotlib.pyplot as plt  # noqa: E402  (the backend must be chosen first)
+from matplotlib.lines import Line2D  # noqa: E402
+from matplotlib.patches import Patch  # noqa: E402
+
+from fjsp_planner.observe import views  # noqa: E402
+from fjsp_planner.observe.history import FleetHistory, MissionHistory  # noqa: E402
+
+FIRST_PLAN, LAST_PLAN, WORK, ACTIVITY = 0.34, 0.18, -0.04, -0.3
+"""Offsets of the lanes within a robot's row (row height 1)."""
+OUTCOME_STYLE = {
+    'done': {'alpha': 1.0, 'hatch': None, 'edgecolor': 'black'},
+    'running': {'alpha': 0.9, 'hatch': None, 'edgecolor': 'black', 'linestyle': ':'},
+    'aborted': {'alpha': 0.6, 'hatch': 'xx', 'edgecolor': 'red'},
+    'voided': {'alpha': 0.35, 'hatch': '\\\\', 'edgecolor': 'dimgrey'},
+}
+ACTIVITY_STYLE = {
+    'travelling': {'color': 'black', 'linewidth': 1.6, 'linestyle': '-'},
+    'waiting': {'color': 'grey', 'linewidth': 1.2, 'linestyle': ':'},
+    'holding': {'color': 'royalblue', 'linewidth': 3.0, 'linestyle': '-'},
+}
+HEALTH_COLOUR = {'failed': ('red', 0.14), 'offline': ('grey', 0.28)}
+
+
+def job_colours(jobs) -> dict:
+    palette = plt.get_cmap('tab20')
+    return {job: palette(index % 20) for index, job in enumerate(sorted(set(jobs)))}
+
+
+def draw_mission(timeline: dict, header: dict, path: Path) -> Path:
+    """Write the chart of `timeline` (from `views.timeline`) to `path` (PNG); returns it."""
+    robots = timeline['robots']
+    rows = {robot: len(robots) - 1 - index for index, robot in enumerate(robots)}
+    end = max(timeline['end'] or 1.0, 1.0)
+    now = timeline['now']
+    colour = job_colours([w['job'] for w in timeline['work']]
+                         + [t['job'] for p in timeline['plans'] for t in p['tasks']])
+    notes = [f"r{r['number']} at t={r['time']:.1f}: "
+             + ('; '.join(r['reasons']) or 'no reason given')
+             for r in timeline['revisions'] if r['number'] > 1 and r['time'] is not None]
+    # Heights in inches: title, one per robot, axis and legend, a line per revision's reasons.
+    below = 1.1 + 0.17 * len(notes)
+    height = 0.65 + 0.95 * len(robots) + below
+    width = min(28.0, max(11.0, 0.1 * end + 7))
+    fig, ax = plt.subplots(figsize=(width, height))
+    label = 0.2 + 0.075 * max((len(r) for r in robots), default=4)
+    fig.subplots_adjust(left=label / width, right=0.99, top=1 - 0.55 / height,
+                        bottom=below / height)
+
+    def clip(value):
+        return end if value is None else max(value, 0.0)
+
+    for span in timeline['health']:
+        if span['robot'] in rows:
+            y = rows[span['robot']]
+            colour_, alpha = HEALTH_COLOUR.get(span['kind'], ('grey', 0.2))
+            start, stop = clip(span['start']), clip(now if span['open'] else span['end'])
+            ax.barh(y, stop - start, left=start, height=0.96, color=colour_, alpha=alpha, lw=0)
+            ax.plot([start], [y + 0.44], marker='X', color='red', markersize=9)
+            if not span['open']:
+                ax.plot([stop], [y + 0.44], marker='^', color='green', markersize=8)
+    lanes = [FIRST_PLAN, LAST_PLAN] if len(timeline['plans']) > 1 else [(FIRST_PLAN +
+                                                                         LAST_PLAN) / 2]
+    for plan, lane in zip(timeline['plans'], lanes, strict=False):
+        latest = plan is timeline['plans'][-1] and len(timeline['plans']) > 1
+        for t in plan['tasks']:
+            if t['robot'] not in rows:
+                continue
+            y = rows[t['robot']] + lane
+            if t['arrival'] > t['travel_start']:
+                ax.plot([clip(t['travel_start']), clip(t['arrival'])], [y, y], color='grey',
+                        lw=0.8)
+            ax.barh(y, t['end'] - t['start'], left=t['start'], height=0.12,
+                    color=colour[t['job']] if latest else 'none', alpha=0.45 if latest else 1,
+                    edgecolor=colour[t['job']] if latest else 'dimgrey',
+                    linestyle='-' if latest else '--', lw=0.8)
+    for w in timeline['work']:
+        if w['robot'] not in rows:
+            continue
+        y = rows[w['robot']] + WORK
+        stop = clip(now if w['open'] else w['end'])
+        style = OUTCOME_STYLE.get(w['outcome'], OUTCOME_STYLE['done'])
+        ax.barh(y, max(stop - w['start'], 0.05), left=w['start'], height=0.3,
+                color=colour[w['job']], **style)
+        label = w['job'] + (f"#{w['attempt']}" if w['attempt'] > 1 else '')
+        ax.text((w['start'] + stop) / 2, y, label, ha='center', va='center', fontsize=6.5,
+                color='black' if w['outcome'] != 'voided' else 'dimgrey')
+    for a in timeline['activities']:
+        style = ACTIVITY_STYLE.get(a['mode'])
+        if style and a['robot'] in rows:
+            start, stop = clip(a['start']), clip(now if a['open'] else a['end'])
+            if stop > start:
+                y = rows[a['robot']] + ACTIVITY
+                ax.plot([start, stop], [y, y], solid_capstyle='butt', **style)
+    for r in timeline['revisions']:
+        if r['time'] is None:
+            continue
+        x = max(r['time'], 0.0)
+        ax.axvline(x, color='purple', linestyle='--', lw=1)
+        ax.text(x, len(robots) - 0.45, f" r{r['number']}", color='purple', fontsize=8,
+                va='bottom')
+    if now is not None and not header['ended']:
+        ax.axvline(now, color='black', lw=1.2)
+        ax.text(now, -0.62, ' now', fontsize=8)
+    ax.set_yticks(range(len(robots)), list(reversed(robots)))
+    ax.set_ylim(-0.65, len(robots) - 0.3)
+    ax.set_xlim(0, end * 1.02)
+    ax.grid(axis='x', alpha=0.25)
+    ax.set_xlabel('schedule time units')
+    ax.set_title(_title(header), fontsize=10)
+    fig.legend(handles=_legend(len(timeline['plans'])), loc='lower center', fontsize=7,
+               ncol=7, bbox_to_anchor=(0.5, (0.08 + 0.17 * len(notes)) / height),
+               frameon=False)
+    if notes:
+        fig.text(0.01, 0.06 / height, '\n'.join(notes), fontsize=7.5, va='bottom')
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def write_mission(fleet: FleetHistory, mission: MissionHistory, now: float, png: Path) -> None:
+    """The mission's chart to `png`, and what it was drawn from beside it (`.json`: the
+    mission line, the timeline and the story, for other tools)."""
+    header, timeline = views.header(mission, now), views.timeline(fleet, mission, now)
+    draw_mission(timeline, header, png)
+    Path(png).with_suffix('.json').write_text(json.dumps(
+        {'mission': header, 'timeline': timeline, 'story': views.story(fleet, mission, now)},
+        indent=1, allow_nan=False))
+
+
+def _title(h: dict) -> str:
+    agree = '' if h['agrees'] or not h['status_jobs'] else \
+        f" (planner says {h['status_jobs'][0]}/{h['status_jobs'][1]})"
+    executed = h['executed_makespan']
+    return (f"{h['scenario']} - mission {h['mission_id']}: {h['state']}, "
+            f"{h['jobs_done']}/{h['jobs_total']} jobs done{agree}\nrevision {h['revision']}; "
+            f"makespan planned {_n(h['first_makespan'])} (r1), {_n(h['planned_makespan'])} "
+            f"(latest), executed {_n(executed)}")
+
+
+def _n(value) -> str:
+    return '-' if value is None else f'{value:.1f}'
+
+
+def _legend(plans: int) -> list:
+    handles = []
+    if plans > 1:
+        handles += [Patch(facecolor='none', edgecolor='dimgrey', linestyle='--',
+                          label='planned, revision 1'),
+                    Patch(facecolor='tab:blue', alpha=0.45, label='planned, latest revision')]
+    else:
+        handles.append(Patch(facecolor='none', edgecolor='dimgrey', linestyle='--',
+                             label='planned'))
+    handles += [
+        Patch(facecolor='tab:blue', edgecolor='black', label='work done (colour: job)'),
+        Patch(facecolor='tab:blue', alpha=0.6, hatch='xx', edgecolor='red',
+              label='aborted attempt'),
+        Patch(facecolor='tab:blue', alpha=0.35, hatch='\\\\', edgecolor='dimgrey',
+              label='voided attempt (redone)'),
+        Line2D([], [], **ACTIVITY_STYLE['travelling'], label='travelling'),
+        Line2D([], [], **ACTIVITY_STYLE['waiting'], label='waiting'),
+        Line2D([], [], **ACTIVITY_STYLE['holding'], label='holding a part'),
+        Patch(facecolor='red', alpha=0.14, label='failed'),
+        Patch(facecolor='grey', alpha=0.28, label='offline'),
+        Line2D([], [], marker='X', color='red', linestyle='none', label='fault'),
+        Line2D([], [], marker='^', color='green', linestyle='none', label='back in service'),
+        Line2D([], [], color='purple', linestyle='--', label='revision published'),
+    ]
+    return handles

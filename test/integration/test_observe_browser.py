@@ -1,0 +1,112 @@
+"""The live mission page in a real headless browser (Debian's Chromium through Selenium): a
+fleet runs, a robot fails mid-mission, and the page shows what a person watching it must see.
+"""
+
+import socket
+import time
+from pathlib import Path
+
+import pytest
+from browser import find_chromium, headless_browser
+
+from fjsp_msgs.msg import MissionStatus
+
+SCENARIO = Path(__file__).resolve().parents[2] / 'config' / 'scenarios' / 'solar_panel.yaml'
+ROBOTS = ('Assembler', 'LSMS', 'MARC1', 'MARC2')
+
+if find_chromium() is None:
+    pytest.skip('Chromium and chromedriver not found (on Debian: apt-get install chromium '
+                'chromium-driver); the live page cannot be tested in a browser',
+                allow_module_level=True)
+
+from selenium.common.exceptions import TimeoutException  # noqa: E402
+from selenium.webdriver.support.ui import WebDriverWait  # noqa: E402
+
+SLOW = 0.1
+"""Wall seconds per schedule unit."""
+
+
+def free_port() -> int:
+    with socket.socket() as probe:
+        probe.bind(('127.0.0.1', 0))
+        return probe.getsockname()[1]
+
+
+def wait_listening(port: int, timeout: float) -> None:
+    deadline = time.monotonic() + timeout
+    while True:
+        try:
+            socket.create_connection(('127.0.0.1', port), timeout=1).close()
+            return
+        except OSError:
+            if time.monotonic() > deadline:
+                pytest.fail(f'the monitor did not serve its page on port {port} within '
+                            f'{timeout:g} s')
+            time.sleep(0.2)
+
+
+# The page redraws its parts as updates come, so it is read in one script call each time
+# (an element found a moment ago may already have been replaced).
+
+def text(page, selector: str) -> str:
+    return page.execute_script(
+        'const e = document.querySelector(arguments[0]); return e ? e.textContent : ""',
+        selector)
+
+
+def attributes(page, selector: str, name: str) -> list[str]:
+    return page.execute_script(
+        'return [...document.querySelectorAll(arguments[0])]'
+        '.map(e => e.getAttribute(arguments[1]))', selector, name)
+
+
+def wait_page(page, condition, timeout, what):
+    try:
+        WebDriverWait(page, timeout, poll_frequency=0.2).until(lambda p: condition(p))
+    except TimeoutException:
+        pytest.fail(f'the page did not show {what} within {timeout:g} s; it shows:\n'
+                    + page.execute_script('return document.body.innerText'))
+
+
+def story(page) -> list[str]:
+    return page.execute_script(
+        'return [...document.querySelectorAll("#story li")].map(e => e.textContent)')
+
+
+def test_live_page_follows_a_mission_through_a_failure(fjsp_fleet, tmp_path):
+    port = free_port()
+    fleet = fjsp_fleet(SCENARIO, time_scale=SLOW)
+    fleet.start_monitor(out_dir=tmp_path, web_port=port)
+    fleet.start_planner()
+    for robot in ROBOTS:
+        fleet.start_agent(robot)
+    wait_listening(port, 30)
+    with headless_browser() as page:
+        page.get(f'http://127.0.0.1:{port}/')
+        wait_page(page, lambda p: text(p, '#state') == 'executing', 60, 'the mission executing')
+        assert attributes(page, '#connection', 'data-state') == ['live']
+        assert text(page, '#revision') == '1'
+        assert set(attributes(page, '#robots tbody tr', 'data-robot')) == {
+            robot for robot in ROBOTS}
+
+        fleet.wait_for(lambda o: o.status and o.status.elapsed >= 8, 60, 'schedule time 8')
+        fleet.inject_fault('MARC1', 'fail')
+        wait_page(page, lambda p: text(p, '#robots tr[data-robot="MARC1"] td.mode') == 'failed',
+                  20, 'MARC1 failed in the robots table')
+        wait_page(page, lambda p: int(text(p, '#revision') or 0) >= 2, 30, 'revision 2')
+        wait_page(page, lambda p: any('revision 2 planned' in line for line in story(p)), 10,
+                  'the re-plan in the events')
+        assert any(line.endswith('MARC1 failed') for line in story(page)), story(page)
+        assert attributes(page, '#timeline rect.health.failed', 'class')
+        assert len(attributes(page, '#timeline line.revision', 'class')) >= 2
+
+        fleet.inject_fault('MARC1', 'recover')
+        fleet.wait_for(lambda o: o.status.state == MissionStatus.STATE_COMPLETE, 90,
+                          'the mission to complete')
+        wait_page(page, lambda p: text(p, '#state') == 'complete' and text(p, '#jobs') == '12/12',
+                  20, 'the mission complete, 12/12')
+        assert any('MARC1 back in service' in line for line in story(page)), story(page)
+        assert any('mission complete: 12/12 jobs done' in line for line in story(page))
+        assert len(set(attributes(page, '#timeline rect.work.done', 'data-job'))) == 12
+        errors = [e for e in page.get_log('browser') if e['level'] == 'SEVERE']
+        assert not errors, errors
