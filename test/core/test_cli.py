@@ -55,7 +55,9 @@ def test_greedy_solver_and_panels(tmp_path):
     ([PAPER, '--time-limit', 'soon'], 'not a number'),
     ([PAPER, '--solver', 'gurobi'], 'invalid choice'),
     ([PAPER, '--shift', '-1'], 'must not be negative'),
-], ids=['missing file', 'zero panels', 'bad time limit', 'unknown solver', 'negative shift'])
+    ([PAPER, '--workers', '999999'], "must be at most 64, got '999999'"),
+], ids=['missing file', 'zero panels', 'bad time limit', 'unknown solver', 'negative shift',
+        'too many workers'])
 def test_bad_arguments_exit_2_with_a_message(args, message):
     run = fjsp_solve(*args)
     assert run.returncode == 2

@@ -8,7 +8,7 @@ from pathlib import Path
 
 from fjsp_planner.core.problem import ProblemError
 from fjsp_planner.core.schedule import Result
-from fjsp_planner.core.solve import SOLVERS, solve
+from fjsp_planner.core.solve import MAX_WORKERS, SOLVERS, solve
 from fjsp_planner.core.validate import validate
 
 EXIT_BAD_INPUT = 2
@@ -23,7 +23,8 @@ def main(argv=None) -> int:
     parser.add_argument('--panels', type=_positive_int, help='repeat the jobs N times')
     parser.add_argument('--shift', type=_non_negative, help='distance between panels')
     parser.add_argument('--time-limit', type=_positive, default=10.0, metavar='S')
-    parser.add_argument('--workers', type=_positive_int, default=2, metavar='K')
+    parser.add_argument('--workers', type=_workers, default=2, metavar='K',
+                        help=f'CP-SAT search workers, 1..{MAX_WORKERS}')
     parser.add_argument('--solver', choices=SOLVERS, default='cpsat')
     parser.add_argument('--mip-backend', choices=('SCIP', 'HIGHS'), default='SCIP')
     parser.add_argument('--json', type=Path, metavar='OUT', help='write the result as JSON')
@@ -135,6 +136,13 @@ def _positive_int(text):
     value = _parse(text, int)
     if value < 1:
         raise argparse.ArgumentTypeError(f'must be a positive integer, got {text!r}')
+    return value
+
+
+def _workers(text):
+    value = _positive_int(text)
+    if value > MAX_WORKERS:
+        raise argparse.ArgumentTypeError(f'must be at most {MAX_WORKERS}, got {text!r}')
     return value
 
 

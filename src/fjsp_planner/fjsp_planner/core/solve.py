@@ -5,12 +5,21 @@ import time
 from fractions import Fraction
 
 from fjsp_planner.core.cpsat import solve_cpsat
-from fjsp_planner.core.greedy import GreedyStuckError, greedy_schedule
+from fjsp_planner.core.greedy import (
+    GreedyOutOfTimeError,
+    GreedyStuckError,
+    greedy_schedule,
+)
 from fjsp_planner.core.problem import Problem
 from fjsp_planner.core.schedule import Result, Schedule, Status
 from fjsp_planner.core.validate import validate
 
 SOLVERS = ('cpsat', 'greedy', 'mip')
+MAX_WORKERS = 64
+"""More search workers than this only thrash on any machine the fleet's planner runs on, and
+CP-SAT rejects absurd counts with an opaque "model invalid"."""
+GREEDY_SHARE = 0.4
+"""Share of the time limit the greedy schedule may take before the exact solver starts."""
 
 
 def solve(problem: Problem, solver: str = 'cpsat', time_limit: float = 10.0, workers: int = 2,
@@ -22,25 +31,38 @@ def solve(problem: Problem, solver: str = 'cpsat', time_limit: float = 10.0, wor
     only) then prefers, among schedules of the proven best makespan, those that change the
     fewest of its (job, robot) assignments. The greedy schedule bounds the horizon and is
     returned when an exact solver finds nothing in time.
+
+    The whole call (greedy, model building, solving, keeping assignments) takes at most
+    `time_limit` seconds, plus the solver's reaction time to its own limit (milliseconds),
+    for problems up to the size limit of the scenario checks (about 1000 jobs). `workers`
+    must lie in 1..MAX_WORKERS.
     """
     if solver not in SOLVERS:
         raise ValueError(f"unknown solver '{solver}'; choose one of {', '.join(SOLVERS)}")
+    if isinstance(workers, bool) or not isinstance(workers, int) or not (
+            1 <= workers <= MAX_WORKERS):
+        raise ValueError(f'workers must be an integer from 1 to {MAX_WORKERS}, got {workers!r}')
+    if not time_limit > 0:
+        raise ValueError(f'time_limit must be a positive number of seconds, got {time_limit!r}')
     began = time.monotonic()
     notes = ()
     if hint is not None and validate(problem, hint):
         # Repairing a broken hint can cost CP-SAT more than starting from the greedy one.
         hint, notes = None, ('the hint is not a valid schedule of this problem; ignored',)
+    greedy_time = time_limit if solver == 'greedy' else GREEDY_SHARE * time_limit
     try:
-        greedy = greedy_schedule(problem)
+        greedy = greedy_schedule(problem, deadline=began + greedy_time)
     except GreedyStuckError:
         greedy = None
+    except GreedyOutOfTimeError:
+        greedy, notes = None, notes + (f'no greedy schedule within {greedy_time:g} s',)
     if greedy is not None and validate(problem, greedy):
         # Its makespan would cap the horizon; an invalid one could make CP-SAT miss schedules.
         greedy, notes = None, notes + ('the greedy schedule was invalid; not used',)
     if solver == 'greedy':
         if greedy is None:
             return Result(Status.UNKNOWN, None, None, time.monotonic() - began, None, 'greedy',
-                          notes=('greedy scheduling got stuck; try an exact solver',))
+                          notes=notes or ('greedy scheduling got stuck; try an exact solver',))
         elapsed = time.monotonic() - began
         return Result(Status.FEASIBLE, greedy.makespan, critical_path_bound(problem), elapsed,
                       greedy, 'greedy', first_solution_seconds=elapsed)
