@@ -2,8 +2,9 @@
 
 import dataclasses
 import time
-from fractions import Fraction
 
+from fjsp_planner.core import bounds
+from fjsp_planner.core.bounds import critical_path_bound
 from fjsp_planner.core.cpsat import solve_cpsat
 from fjsp_planner.core.greedy import (
     GreedyOutOfTimeError,
@@ -20,6 +21,10 @@ MAX_WORKERS = 64
 CP-SAT rejects absurd counts with an opaque "model invalid"."""
 GREEDY_SHARE = 0.4
 """Share of the time limit the greedy schedule may take before the exact solver starts."""
+PANEL_BOUND_SHARE = 0.1
+"""Share of the time limit kept, on several identical panels, to bound one panel done without
+the robots that cannot move between panels (`bounds.unhelped_panel`)."""
+MIN_PANEL_BOUND_SECONDS = 0.2
 
 
 def solve(problem: Problem, solver: str = 'cpsat', time_limit: float = 10.0, workers: int = 2,
@@ -68,6 +73,10 @@ def solve(problem: Problem, solver: str = 'cpsat', time_limit: float = 10.0, wor
                       greedy, 'greedy', first_solution_seconds=elapsed)
     setup = time.monotonic() - began
     remaining = max(0.05, time_limit - setup)
+    panel_time = 0.0
+    if solver == 'cpsat' and len(problem.panels) >= 2 and not problem.fixed:
+        panel_time = PANEL_BOUND_SHARE * time_limit
+        remaining = max(0.05, remaining - panel_time)
     if solver == 'mip':
         from fjsp_planner.core.mip import solve_mip
 
@@ -83,7 +92,31 @@ def solve(problem: Problem, solver: str = 'cpsat', time_limit: float = 10.0, wor
                       best_solution_seconds=setup,
                       notes=result.notes + (f'{result.solver} found no schedule in '
                                             f'{time_limit:g} s; greedy schedule returned',))
-    return _count_from(problem, dataclasses.replace(result, notes=notes + result.notes), setup)
+    result = _count_from(problem, dataclasses.replace(result, notes=notes + result.notes), setup)
+    if result.schedule is not None and panel_time:
+        result = _with_panel_bounds(problem, result, began + time_limit, workers)
+    return result
+
+
+def _with_panel_bounds(problem: Problem, result: Result, deadline: float, workers) -> Result:
+    """The result with its bound raised by the panel decomposition bounds (bounds.py)."""
+    best = result.makespan
+    found = [b for b in (bounds.panel_energy_bound(problem, best),) if b is not None]
+    panel = bounds.unhelped_panel(problem, best)
+    seconds = deadline - time.monotonic()
+    if panel is not None and seconds > MIN_PANEL_BOUND_SECONDS:
+        alone = solve_cpsat(panel, seconds, workers, lns_share=0)
+        if alone.lower_bound is not None:
+            found.append(alone.lower_bound)
+    if not found:
+        return result
+    raised = min(max(result.lower_bound or 0, *found), best)
+    if raised <= (result.lower_bound or 0):
+        return result
+    return dataclasses.replace(
+        result, lower_bound=raised, solve_seconds=result.solve_seconds + (
+            time.monotonic() - (deadline - seconds)),
+        notes=result.notes + (f'bound raised to {float(raised):g} by panel decomposition',))
 
 
 def _count_from(problem: Problem, result: Result, setup: float) -> Result:
@@ -99,32 +132,3 @@ def _count_from(problem: Problem, result: Result, setup: float) -> Result:
         result, lower_bound=bound, solve_seconds=result.solve_seconds + setup,
         first_solution_seconds=shifted(result.first_solution_seconds),
         best_solution_seconds=shifted(result.best_solution_seconds))
-
-
-def critical_path_bound(problem: Problem) -> Fraction:
-    """Longest precedence chain, each job at its fastest possible duration."""
-    fastest = {}
-    for job in problem.jobs:
-        fixed = problem.fixed.get(job.name)
-        if fixed is not None:
-            fastest[job.name] = fixed.end - fixed.start
-            continue
-        per_plan = []
-        for plan in job.plans:
-            times = [min((t for r in problem.robots
-                          if (t := problem.duration(r.name, q)) is not None),
-                         default=Fraction(0)) for q in plan]
-            per_plan.append(max(times))
-        fastest[job.name] = min(per_plan)
-    starts = {job.name: Fraction(0) for job in problem.jobs}
-    for name, fixed in problem.fixed.items():
-        starts[name] = fixed.start
-    ends = {}
-
-    def end(name):
-        if name not in ends:
-            ready = max((end(a) for a in problem.predecessors(name)), default=starts[name])
-            ends[name] = max(ready, starts[name]) + fastest[name]
-        return ends[name]
-
-    return max((end(j.name) for j in problem.jobs), default=Fraction(0))

@@ -8,6 +8,8 @@ valid (docs/solver.md has the argument in full).
 
 from fractions import Fraction
 
+from fjsp_planner.core import bounds
+from fjsp_planner.core.bounds import crossing_cost
 from fjsp_planner.core.cpsat.grid import TimeGrid
 from fjsp_planner.core.cpsat.variables import JobVariables, RouteVariables
 from fjsp_planner.core.problem import Problem
@@ -98,15 +100,9 @@ class PanelVariables:
         self.crossings = {}
         self.symmetry = None
         """(robot, first panel, last panel) when mirrored panels are cut off."""
-        self.one_panel = []
-        """Robots kept to one panel because crossing costs them more than a known schedule."""
-
-
-def crossing_cost(problem: Problem, robot: str) -> Fraction:
-    """Least travel time for the robot between jobs of two different panels."""
-    return min(problem.travel(robot, problem.job(a).location, problem.job(b).location)
-               for k, first in enumerate(problem.panels) for second in problem.panels[k + 1:]
-               for a in first for b in second)
+        self.limits = {}
+        """robot -> most panels it may visit: more would make it no shorter than a known
+        schedule (`bounds.panel_limits`)."""
 
 
 def panels(m, problem: Problem, grid: TimeGrid, jobs: JobVariables, makespan,
@@ -114,14 +110,16 @@ def panels(m, problem: Problem, grid: TimeGrid, jobs: JobVariables, makespan,
     """Cuts for identical panels (SPEC §1.2 instances, no running jobs):
 
     - a robot's work, its release time and its moves between panels fit in the makespan;
-    - a robot whose cheapest move between panels alone takes longer than a known schedule
-      (`incumbent`) works in one panel at most: moving would make a schedule no shorter;
+    - a robot visits at most the panels it can reach within a known schedule's makespan
+      (`incumbent`, `bounds.panel_limits`): visiting more makes a schedule no shorter, and
+      the known schedule itself stays allowed;
     - mirrored solutions (panel k <-> N+1-k) are searched only once.
     """
     out = PanelVariables()
     if len(problem.panels) < 2 or problem.fixed:
         return out
     costs = {}
+    out.limits = bounds.panel_limits(problem, incumbent) if incumbent is not None else {}
     for robot in problem.robots:
         r = robot.name
         visits = []
@@ -137,9 +135,9 @@ def panels(m, problem: Problem, grid: TimeGrid, jobs: JobVariables, makespan,
         m.add(crossings >= sum(visits) - 1)
         work = sum(jobs.longest[j, r] for j in jobs.jobs_of(r, [j.name for j in problem.jobs]))
         m.add(work + grid.ticks(cost) * crossings + grid.ticks(robot.release_time) <= makespan)
-        if incumbent is not None and robot.release_time + cost > incumbent:
-            m.add(sum(visits) <= 1)
-            out.one_panel.append(r)
+        most = out.limits.get(r)
+        if most is not None:
+            m.add(sum(visits) <= most)
     if any(r.start_location for r in problem.robots):
         return out
     slowest = max(costs, key=costs.get)

@@ -6,7 +6,7 @@ from fractions import Fraction
 
 from ortools.sat.python import cp_model
 
-from fjsp_planner.core.cpsat import objective
+from fjsp_planner.core.cpsat import lns, objective
 from fjsp_planner.core.cpsat.model import CpsatModel
 from fjsp_planner.core.cpsat.variables import OutOfTimeError
 from fjsp_planner.core.problem import Problem
@@ -16,16 +16,21 @@ KEEP_SHARE = 0.3
 """At most this share of the time limit goes, once the makespan is proven, to keeping
 previous assignments; an unproven makespan gets the whole limit."""
 MIN_SOLVE_SECONDS = 0.01
+LNS_SHARE = 0.5
+MIN_LNS_SECONDS = 1.0
+"""Below this, a neighbourhood solve has no time to improve anything."""
 
 
 def solve_cpsat(problem: Problem, time_limit=10.0, workers=2, hint: Schedule | None = None,
                 keep: Schedule | None = None, upper_bound: Schedule | None = None,
-                log=False) -> Result:
+                log=False, lns_share=LNS_SHARE) -> Result:
     """Minimise the makespan; with `keep`, then prefer `keep`'s (job, robot) assignments.
 
     `upper_bound` is a valid schedule (e.g. greedy) that sets the horizon and is hinted
-    unless `hint` is given. The whole call, model building included, ends within
-    `time_limit` seconds (plus CP-SAT's own reaction time to its limit, a few ms).
+    unless `hint` is given. Unless the whole model is solved to optimality first, the last
+    `lns_share` of the time goes to large-neighbourhood search from its best schedule
+    (`lns.improve`); the bound is the whole model's. The whole call, model building
+    included, ends within `time_limit` seconds (plus CP-SAT's reaction time to its limit).
     """
     began = time.monotonic()
     deadline = began + time_limit
@@ -38,7 +43,10 @@ def solve_cpsat(problem: Problem, time_limit=10.0, workers=2, hint: Schedule | N
         model.add_hint(hint or upper_bound)
     model.minimize_makespan()
     setup = time.monotonic() - began
-    solver, recorder, status = run(model.model, deadline - time.monotonic(), workers, log)
+    whole = deadline - time.monotonic()
+    if lns_share and whole > MIN_LNS_SECONDS:
+        whole *= 1 - lns_share
+    solver, recorder, status = run(model.model, whole, workers, log)
     if status == 'INFEASIBLE':
         return Result(Status.INFEASIBLE, None, None, time.monotonic() - began, None, 'cpsat',
                       notes=model.notes)
@@ -50,6 +58,10 @@ def solve_cpsat(problem: Problem, time_limit=10.0, workers=2, hint: Schedule | N
     best = solver.value(model.makespan)
     bound = Fraction(math.ceil(solver.best_objective_bound), model.grid.scale)
     schedule = model.read(solver)
+    if status != 'OPTIMAL' and deadline - time.monotonic() > MIN_LNS_SECONDS:
+        improved = lns.improve(model, schedule, deadline, workers, run)
+        if improved.makespan < schedule.makespan:
+            schedule, recorder.best = improved, time.monotonic() - began - setup
     if keep is not None and status == 'OPTIMAL':
         keep_time = min(time_limit * KEEP_SHARE, deadline - time.monotonic())
         if keep_time > MIN_SOLVE_SECONDS:
