@@ -21,6 +21,7 @@ robot may come back, and a later state then gives a solvable residual. Holds tha
 schedule at all (each holder waiting for the other's held job) are given up by `replan`.
 """
 
+import dataclasses
 from collections import Counter
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
@@ -132,6 +133,73 @@ def _solve(residual: Problem, previous: Schedule, time_limit, workers) -> Result
     """
     return solve(residual, time_limit=time_limit, workers=workers,
                  hint=_project(residual, previous), keep=previous)
+
+
+def repair(problem: Problem, previous: Schedule, state: ExecutionState,
+           time_limit: float = 0.3) -> Replan:
+    """A valid plan of what remains, at once: the first stage of anytime re-planning.
+
+    The better of the greedy schedule of the residual problem and the previous plan restricted
+    to it (when that still works), without any search: publish it, then call `improve`.
+    Holds that deadlock are given up as in `replan`. `time_limit` bounds the greedy (a 5-panel
+    residual takes ~0.1 s).
+    """
+    residual = residual_problem(problem, state, previous)
+    if residual.problem is None:
+        return Replan(residual, None, [])
+    result = solve(residual.problem, solver='greedy', time_limit=time_limit)
+    holding = {a for a, _, _ in residual.problem.holding if a in residual.problem.fixed}
+    if result.schedule is None and holding:
+        residual = residual_problem(problem, state, previous, release=holding)
+        if residual.problem is None:
+            return Replan(residual, None, [])
+        result = solve(residual.problem, solver='greedy', time_limit=time_limit)
+    projected = _project(residual.problem, previous)
+    if projected is not None and not validate(residual.problem, projected) and (
+            result.schedule is None or projected.makespan <= result.schedule.makespan):
+        result = dataclasses.replace(result, makespan=projected.makespan, schedule=projected,
+                                     notes=result.notes + ('the previous plan still works',))
+    problems = [] if result.schedule is None else validate(residual.problem, result.schedule)
+    return Replan(residual, result, problems)
+
+
+@dataclass(frozen=True)
+class Improvement:
+    replan: Replan
+    """The better plan (or the published one, unchanged), on the same residual problem."""
+    improved: bool
+    """The new plan is shorter than the published one by more than `margin`: worth a new
+    revision. False keeps agents on the published plan rather than thrash for a few %."""
+
+
+IMPROVE_MARGIN = 0.02
+
+
+def improve(published: Replan, time_limit: float = 2.0, workers: int = 2,
+            margin: float = IMPROVE_MARGIN) -> Improvement:
+    """The second stage of anytime re-planning: search from the published plan.
+
+    CP-SAT starts from `published` (a `repair` or earlier `improve` outcome) and, among the
+    shortest schedules it finds, prefers those moving the fewest robots off it. `improved`
+    says whether the result beats the published makespan by more than `margin` (a share).
+    The residual problem is the published one's, posed at the failure's time: jobs the
+    agents finished meanwhile stay in it, so re-pose with `repair` before publishing if the
+    mission moved on far.
+    """
+    residual = published.residual
+    if residual.problem is None or published.schedule is None:
+        return Improvement(published, False)
+    result = solve(residual.problem, time_limit=time_limit, workers=workers,
+                   hint=published.schedule, keep=published.schedule)
+    if result.schedule is None or validate(residual.problem, result.schedule):
+        return Improvement(published, False)
+    better = result.makespan < published.schedule.makespan * (1 - Fraction(margin))
+    if not better:
+        # Same plan, but the search may have proven it optimal: keep its bound.
+        kept = dataclasses.replace(published.result, lower_bound=max(
+            published.result.lower_bound or 0, result.lower_bound or 0))
+        return Improvement(Replan(residual, kept, published.problems), False)
+    return Improvement(Replan(residual, result, []), True)
 
 
 def _project(residual: Problem, previous: Schedule) -> Schedule | None:
