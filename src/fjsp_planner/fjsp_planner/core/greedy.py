@@ -107,6 +107,8 @@ class _State:
         self.held_from = {b: (a, q) for a, b, q in problem.holding}
         self.order = {j.name: i for i, j in enumerate(problem.jobs)}
         self.durations = {}
+        self.guide = {}
+        """job -> its assignment in a schedule to follow (`guided_schedule`)."""
         self.predecessors = {j.name: [] for j in problem.jobs}
         for a, b in problem.precedence:
             self.predecessors[b].append(a)
@@ -206,8 +208,18 @@ def _first_pass(problem: Problem, deadline) -> Schedule:
         return _one_pass(problem, None, deadline, QUICK)
 
 
-def _one_pass(problem: Problem, rng, deadline=None, breadth=None) -> Schedule:
+def guided_schedule(problem: Problem, guide: Schedule, deadline: float | None = None
+                    ) -> Schedule:
+    """A schedule that follows `guide` (e.g. the plan a failure broke) as far as it still
+    can: jobs are placed in the guide's start order, each with the guide's plan and robots
+    when they can still do it, the rest (a failed robot's jobs, new jobs) where they end
+    soonest. Raises GreedyStuckError or GreedyOutOfTimeError like `greedy_schedule`."""
+    return _one_pass(problem, None, deadline, BREADTH, guide)
+
+
+def _one_pass(problem: Problem, rng, deadline=None, breadth=None, guide=None) -> Schedule:
     state = _State(problem, breadth or BREADTH)
+    state.guide = guide.jobs if guide is not None else {}
     for name, fixed in problem.fixed.items():
         state.commit(JobAssignment(name, fixed.plan, fixed.start, fixed.end,
                                    dict(fixed.robots)))
@@ -227,7 +239,7 @@ def _one_pass(problem: Problem, rng, deadline=None, breadth=None) -> Schedule:
         if not options:
             raise GreedyStuckError('greedy scheduling found no job it can place next among '
                               + ', '.join(sorted(pending)))
-        options.sort(key=lambda o: o[0])
+        options.sort(key=lambda o: (_guide_order(state, o[1][0][0]), o[0]))
         if rng is not None and len(options) > 1 and rng.random() < 0.3:
             choice = options[rng.randrange(min(3, len(options)))]
         else:
@@ -236,6 +248,31 @@ def _one_pass(problem: Problem, rng, deadline=None, breadth=None) -> Schedule:
             state.place(name, plan, robots)
             pending.remove(name)
     return Schedule(state.jobs, {r: tuple(s) for r, s in state.sequences.items()})
+
+
+def _guide_order(state: _State, name) -> float:
+    """Where the guide starts the job (unguided passes and new jobs: no preference)."""
+    assignment = state.guide.get(name)
+    return float(assignment.start) if assignment is not None else float('inf')
+
+
+def _guide_first(state: _State, name, ready, forced, candidates):
+    """`candidates` with the guide's staffing of the job first, when it is still possible."""
+    assignment = state.guide.get(name)
+    if assignment is None:
+        return candidates
+    robots = dict(assignment.robots)
+    job = state.problem.job(name)
+    if (assignment.plan >= len(job.plans)
+            or sorted(robots.values()) != sorted(job.plans[assignment.plan])
+            or any(r not in state.free or state.duration_f(r, q) is None
+                   or state.reserved.get(r, name) != name for r, q in robots.items())
+            or any(robots.get(r) != q for r, q in forced.items())):
+        return candidates
+    start = max(float(ready), *(float(state.arrival(r, job.location)) for r in robots))
+    end = start + max(state.duration_f(r, q) for r, q in robots.items())
+    return [(end, start, assignment.plan, robots)] + [
+        c for c in candidates if (c[2], c[3]) != (assignment.plan, robots)]
 
 
 def _by_readiness(state: _State, pending):
@@ -266,12 +303,17 @@ def _block_option(state: _State, name):
     if name in state.held_from:
         _, q = state.held_from[name]
         forced = {r: q for r, target in state.reserved.items() if target == name}
-    candidates = state.candidates(name, ready, forced)
+    candidates = _guide_first(state, name, ready, forced,
+                              state.candidates(name, ready, forced))
     if len(chain) == 1:
         if not candidates:
             return None
         end, _, plan, robots = candidates[0]
         return (end, [(name, plan, robots)])
+    if name in state.guide and candidates:
+        guided = _place_chain(state, chain, candidates[0][2], candidates[0][3])
+        if guided is not None:
+            return guided
     # The jig job's staffing decides who must also do the held job, so judge each staffing
     # by when the whole chain completes, not by when the jig job does.
     best = None
@@ -291,7 +333,9 @@ def _place_chain(state: _State, chain, plan, robots):
     for member in chain[1:]:
         _, q = trial.held_from[member]
         forced = {r: q for r, target in trial.reserved.items() if target == member}
-        options = trial.candidates(member, trial.ready_at(member), forced)
+        ready = trial.ready_at(member)
+        options = _guide_first(trial, member, ready, forced,
+                               trial.candidates(member, ready, forced))
         if not options:
             return None
         end, _, member_plan, member_robots = options[0]

@@ -22,13 +22,16 @@ schedule at all (each holder waiting for the other's held job) are given up by `
 """
 
 import dataclasses
+import time
 from collections import Counter
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from fractions import Fraction
 
+from fjsp_planner.core.bounds import critical_path_bound
+from fjsp_planner.core.greedy import GreedyOutOfTimeError, GreedyStuckError, guided_schedule
 from fjsp_planner.core.problem import FixedJob, Job, Problem, Robot, max_staffed
-from fjsp_planner.core.schedule import JobAssignment, Result, Schedule
+from fjsp_planner.core.schedule import JobAssignment, Result, Schedule, Status
 from fjsp_planner.core.solve import solve
 from fjsp_planner.core.validate import validate
 
@@ -126,39 +129,64 @@ def replan(problem: Problem, previous: Schedule, state: ExecutionState, time_lim
 
 
 def _solve(residual: Problem, previous: Schedule, time_limit, workers) -> Result:
-    """Solve, keeping close to `previous`, and starting from it if it still works.
+    """Solve, keeping close to `previous`, and starting from the best of what it suggests.
 
     A previous plan broken by the failure is a poor start: CP-SAT repairing its stale parts
-    can take longer than finding a schedule afresh from the greedy one.
+    can take longer than finding a schedule afresh. So the search starts from `previous`
+    restricted to what remains if that still works, else from a schedule that follows it
+    where it can (`guided_schedule`), whichever is shorter; `solve` adds the greedy one.
     """
-    return solve(residual, time_limit=time_limit, workers=workers,
-                 hint=_project(residual, previous), keep=previous)
+    began = time.monotonic()
+    start = _starts(residual, previous, began + GUIDE_SHARE * time_limit)
+    return solve(residual, time_limit=max(0.05, time_limit - (time.monotonic() - began)),
+                 workers=workers, hint=start[0] if start else None, keep=previous)
+
+
+GUIDE_SHARE = 0.25
+"""Share of a re-plan's time limit the schedule following the previous plan may take."""
+
+
+def _starts(residual: Problem, previous: Schedule, deadline) -> list[Schedule]:
+    """Valid schedules of `residual` suggested by `previous`, shortest first."""
+    found = []
+    projected = _project(residual, previous)
+    if projected is not None and not validate(residual, projected):
+        found.append(projected)
+    try:
+        guided = guided_schedule(residual, previous, deadline)
+    except (GreedyStuckError, GreedyOutOfTimeError):
+        guided = None
+    if guided is not None and not validate(residual, guided):
+        found.append(guided)
+    return sorted(found, key=lambda schedule: schedule.makespan)
 
 
 def repair(problem: Problem, previous: Schedule, state: ExecutionState,
            time_limit: float = 0.3) -> Replan:
     """A valid plan of what remains, at once: the first stage of anytime re-planning.
 
-    The better of the greedy schedule of the residual problem and the previous plan restricted
-    to it (when that still works), without any search: publish it, then call `improve`.
-    Holds that deadlock are given up as in `replan`. `time_limit` bounds the greedy (a 5-panel
-    residual takes ~0.1 s).
+    The shortest of the previous plan restricted to what remains (when that still works), a
+    schedule following it where it can (`guided_schedule`) and the greedy schedule, without
+    any search: publish it, then call `improve`. Holds that deadlock are given up as in
+    `replan`. `time_limit` bounds the heuristics (a 5-panel residual takes ~0.3 s).
     """
+    began = time.monotonic()
     residual = residual_problem(problem, state, previous)
     if residual.problem is None:
         return Replan(residual, None, [])
-    result = solve(residual.problem, solver='greedy', time_limit=time_limit)
+    result = solve(residual.problem, solver='greedy', time_limit=time_limit / 2)
     holding = {a for a, _, _ in residual.problem.holding if a in residual.problem.fixed}
     if result.schedule is None and holding:
         residual = residual_problem(problem, state, previous, release=holding)
         if residual.problem is None:
             return Replan(residual, None, [])
-        result = solve(residual.problem, solver='greedy', time_limit=time_limit)
-    projected = _project(residual.problem, previous)
-    if projected is not None and not validate(residual.problem, projected) and (
-            result.schedule is None or projected.makespan <= result.schedule.makespan):
-        result = dataclasses.replace(result, makespan=projected.makespan, schedule=projected,
-                                     notes=result.notes + ('the previous plan still works',))
+        result = solve(residual.problem, solver='greedy', time_limit=time_limit / 2)
+    starts = _starts(residual.problem, previous, began + time_limit)
+    if starts and (result.schedule is None or starts[0].makespan < result.schedule.makespan):
+        result = dataclasses.replace(
+            result, status=Status.FEASIBLE, makespan=starts[0].makespan, schedule=starts[0],
+            lower_bound=critical_path_bound(residual.problem),
+            notes=result.notes + ('follows the previous plan where it still can',))
     problems = [] if result.schedule is None else validate(residual.problem, result.schedule)
     return Replan(residual, result, problems)
 

@@ -64,6 +64,9 @@ def solve(problem: Problem, solver: str = 'cpsat', time_limit: float = 10.0, wor
     if greedy is not None and validate(problem, greedy):
         # Its makespan would cap the horizon; an invalid one could make CP-SAT miss schedules.
         greedy, notes = None, notes + ('the greedy schedule was invalid; not used',)
+    if hint is not None and greedy is not None and greedy.makespan < hint.makespan:
+        # The horizon comes from the shorter one, and would cut the longer hint off.
+        hint = greedy
     if solver == 'greedy':
         if greedy is None:
             return Result(Status.UNKNOWN, None, None, time.monotonic() - began, None, 'greedy',
@@ -84,7 +87,7 @@ def solve(problem: Problem, solver: str = 'cpsat', time_limit: float = 10.0, wor
                            hint=hint or greedy, log=log)
     else:
         result = solve_cpsat(problem, remaining, workers, hint=hint, keep=keep,
-                             upper_bound=greedy, log=log)
+                             upper_bound=hint or greedy, log=log)
     if result.schedule is None and greedy is not None and result.status != Status.INFEASIBLE:
         elapsed = time.monotonic() - began
         return Result(Status.FEASIBLE, greedy.makespan, critical_path_bound(problem), elapsed,

@@ -70,6 +70,10 @@ class JobVariables:
             m.add(end == start + duration)
         else:
             duration = fixed_ticks[1] - fixed_ticks[0]
+        # A job of single-operation plans lasts as long as its one robot takes: a fixed-size
+        # interval per robot then tells no-overlap the size before the choice is made (the
+        # classic FJSP is all such jobs).
+        alone = fixed is None and all(len(plan) == 1 for plan in job.plans)
         longest = []
         for r in self.robots:
             mine = [(lit, q) for _, q, lit in self.does.get((name, r), ())]
@@ -78,12 +82,22 @@ class JobVariables:
             on = m.new_bool_var(f'on_{name}_{r}')
             m.add(on == sum(lit for lit, _ in mine))
             self.on_job[name, r] = on
+            sizes = {grid.ticks(p.duration(r, q)) for _, q in mine}
             work = self.longest[name, r] = sum(lit * grid.ticks(p.duration(r, q))
                                                for lit, q in mine)
             longest.append(work)
-            self.busy.setdefault(r, []).append(
-                m.new_optional_interval_var(start, duration, end, on, f'busy_{name}_{r}'))
-        if fixed is None:
+            if alone and len(sizes) == 1:
+                size = sizes.pop()
+                m.add(end == start + size).only_enforce_if(on)
+                interval = m.new_optional_fixed_size_interval_var(start, size, on,
+                                                                  f'busy_{name}_{r}')
+            else:
+                interval = m.new_optional_interval_var(start, duration, end, on,
+                                                       f'busy_{name}_{r}')
+            self.busy.setdefault(r, []).append(interval)
+        if alone:
+            m.add(duration == sum(longest))
+        elif fixed is None:
             m.add_max_equality(duration, longest)
 
     def jobs_of(self, robot: str, names) -> list[str]:
