@@ -73,6 +73,16 @@ def test_decomposition_bounds_never_exceed_the_optimum(two_panels_optimum):
     assert bounds.critical_path_bound(problem) == 3
 
 
+def test_clique_bound_by_hand(two_panels_optimum):
+    """Without S, y needs both arms (more than half of the two): such jobs run one after
+    another. One panel cannot have S; its y lasts 3 (the arms hold in 3, weld in 1), after x
+    (1 at the fastest, by S) and before z (1): 1 + 3 + 1 = 5 <= 11. Three panels, two
+    without S: 1 + 3 + 3 + one move between them (1 for an arm) + 1 = 9."""
+    assert bounds.panel_clique_bound(tiny(2), Fraction(23)) == 5 <= two_panels_optimum
+    assert bounds.panel_clique_bound(tiny(3), Fraction(99)) == 9
+    assert bounds.panel_clique_bound(tiny(3), Fraction(250)) is None
+
+
 def test_a_robot_that_can_cross_within_the_incumbent_is_not_limited():
     """With an incumbent of 250, S could visit 3 panels (2 crossings of 100): no limit."""
     problem = tiny(3)
@@ -83,8 +93,11 @@ def test_a_robot_that_can_cross_within_the_incumbent_is_not_limited():
 
 def test_paper_two_panels_bound_reaches_the_panel_without_the_assembler():
     """The Assembler needs 200 to cross: within the best 2-panel schedules (~92) one panel is
-    done by LSMS and the MARCs alone, which takes 55 1/6 (a 1-panel solve proves it)."""
+    done by LSMS and the MARCs alone, which takes 55 1/6 (a 1-panel solve proves it); its
+    jobs needing two or three of those three robots take 45, the other panel's (with the
+    Assembler) 10, plus a move between the panels (2 for LSMS) and 1 before: 58."""
     problem = load_scenario(PAPER, panels=2)
     result = solve(problem, time_limit=10)
     assert validate(problem, result.schedule) == []
-    assert Fraction(331, 6) <= result.lower_bound <= result.makespan
+    assert bounds.panel_clique_bound(problem, result.makespan) == 58
+    assert 58 <= result.lower_bound <= result.makespan

@@ -102,6 +102,68 @@ def panel_energy_bound(problem: Problem, incumbent: Fraction) -> Fraction | None
     return min((energy + releases) / len(others), incumbent)
 
 
+def panel_clique_bound(problem: Problem, incumbent: Fraction) -> Fraction | None:
+    """The robots `panel_limits` does not limit, G, run every job needing more than half of
+    them one after another: two such jobs together would need more robots of G than exist.
+
+    So the makespan is at least the earliest such a job can start, plus their least
+    durations over all panels (panels the limited robots cannot reach counted without them),
+    plus one move between panels per panel change (two consecutive such jobs share a robot of
+    G), plus the least time after such a job ends. Valid for every schedule shorter than
+    `incumbent`, so min(bound, incumbent) bounds all. None when the premise fails."""
+    limits = panel_limits(problem, incumbent)
+    group = {r.name for r in problem.robots if r.name not in limits}
+    helped_panels = min(len(problem.panels), sum(limits.values()))
+    unhelped_panels = len(problem.panels) - helped_panels
+    if not limits or not group or unhelped_panels < 1:
+        return None
+    heads, tails = _heads_and_tails(problem)
+    total, firsts, lasts, panels_in = Fraction(0), [], [], 0
+    for count, allowed in ((unhelped_panels, group), (helped_panels, group | set(limits))):
+        if count == 0:
+            continue
+        found = False
+        for name in problem.panels[0]:
+            staffings = [s for plan in problem.job(name).plans
+                         for s in _staffings(problem, plan, sorted(allowed))]
+            if not staffings:
+                return None
+            if min(sum(r in group for r, _ in s) for s in staffings) * 2 <= len(group):
+                continue
+            total += count * min(max(problem.duration(r, q) for r, q in s) for s in staffings)
+            firsts.append(heads[name])
+            lasts.append(tails[name])
+            found = True
+        panels_in += count if found else 0
+    if not firsts:
+        return None
+    moves = (panels_in - 1) * min(crossing_cost(problem, r) for r in group)
+    return min(min(firsts) + total + moves + min(lasts), incumbent)
+
+
+def _heads_and_tails(problem: Problem):
+    """job -> least time before it can start / after it ends, along precedence chains at the
+    fastest durations (panel copies have the same heads and tails as panel 0)."""
+    fastest = {}
+    for job in problem.jobs:
+        fastest[job.name] = min(
+            max(min((t for r in problem.robots if (t := problem.duration(r.name, q)) is not None),
+                    default=Fraction(0)) for q in plan) for plan in job.plans)
+    order = _topological(problem)
+    heads = {}
+    for name in order:
+        heads[name] = max((heads[a] + fastest[a] for a in problem.predecessors(name)),
+                          default=Fraction(0))
+    successors = {name: [] for name in order}
+    for a, b in problem.precedence:
+        successors[a].append(b)
+    tails = {}
+    for name in reversed(order):
+        tails[name] = max((fastest[b] + tails[b] for b in successors[name]),
+                          default=Fraction(0))
+    return heads, tails
+
+
 def unhelped_panel(problem: Problem, incumbent: Fraction) -> Problem | None:
     """One panel as a problem of its own, staffed without the robots `panel_limits` keeps
     from some panel, or None when every panel may get them all or the others cannot staff

@@ -104,7 +104,8 @@ def solve(problem: Problem, solver: str = 'cpsat', time_limit: float = 10.0, wor
 def _with_panel_bounds(problem: Problem, result: Result, deadline: float, workers) -> Result:
     """The result with its bound raised by the panel decomposition bounds (bounds.py)."""
     best = result.makespan
-    found = [b for b in (bounds.panel_energy_bound(problem, best),) if b is not None]
+    found = [b for b in (bounds.panel_energy_bound(problem, best),
+                         bounds.panel_clique_bound(problem, best)) if b is not None]
     panel = bounds.unhelped_panel(problem, best)
     seconds = deadline - time.monotonic()
     if panel is not None and seconds > MIN_PANEL_BOUND_SECONDS:
@@ -117,7 +118,9 @@ def _with_panel_bounds(problem: Problem, result: Result, deadline: float, worker
     if raised <= (result.lower_bound or 0):
         return result
     return dataclasses.replace(
-        result, lower_bound=raised, solve_seconds=result.solve_seconds + (
+        result, lower_bound=raised,
+        status=Status.OPTIMAL if raised >= best else result.status,
+        solve_seconds=result.solve_seconds + (
             time.monotonic() - (deadline - seconds)),
         notes=result.notes + (f'bound raised to {float(raised):g} by panel decomposition',))
 
@@ -128,10 +131,13 @@ def _count_from(problem: Problem, result: Result, setup: float) -> Result:
     def shifted(seconds):
         return None if seconds is None else seconds + setup
 
-    bound = result.lower_bound
+    bound, status = result.lower_bound, result.status
     if bound is not None:
-        bound = min(max(bound, critical_path_bound(problem)), result.makespan)
+        path = critical_path_bound(problem)
+        bound = min(max(bound, path), result.makespan)
+        if path >= result.makespan:
+            status = Status.OPTIMAL
     return dataclasses.replace(
-        result, lower_bound=bound, solve_seconds=result.solve_seconds + setup,
+        result, status=status, lower_bound=bound, solve_seconds=result.solve_seconds + setup,
         first_solution_seconds=shifted(result.first_solution_seconds),
         best_solution_seconds=shifted(result.best_solution_seconds))

@@ -67,9 +67,10 @@ def solve_cpsat(problem: Problem, time_limit=10.0, workers=2, hint: Schedule | N
         if keep_time > MIN_SOLVE_SECONDS:
             schedule = _keep_assignments(model, solver, best, keep, keep_time, workers,
                                          log) or schedule
-    proven = status == 'OPTIMAL'
     makespan = schedule.makespan
     lower_bound = min(bound, makespan) if model.grid.exact else bound
+    # A schedule found by the neighbourhood search may meet the whole model's bound.
+    proven = status == 'OPTIMAL' or lower_bound >= makespan
     return Result(
         Status.OPTIMAL if proven and model.grid.exact else Status.FEASIBLE,
         makespan, lower_bound, time.monotonic() - began, schedule, 'cpsat',
