@@ -168,21 +168,28 @@ def unhelped_panel(problem: Problem, incumbent: Fraction) -> Problem | None:
     """One panel as a problem of its own, staffed without the robots `panel_limits` keeps
     from some panel, or None when every panel may get them all or the others cannot staff
     it. Its optimum bounds every schedule shorter than `incumbent`."""
-    from fjsp_planner.core.problem import ProblemError
-
     limits = panel_limits(problem, incumbent)
     if not limits or len(problem.panels) <= sum(limits.values()):
         return None
+    return one_panel(problem, without=set(limits))
+
+
+def one_panel(problem: Problem, without=frozenset()) -> Problem | None:
+    """The first panel as a problem of its own, without the robots `without` (None if the
+    others cannot staff it)."""
+    from fjsp_planner.core.problem import ProblemError
+
     names = set(problem.panels[0])
     try:
         return replace(
-            problem, robots=tuple(r for r in problem.robots if r.name not in limits),
+            problem, robots=tuple(r for r in problem.robots if r.name not in without),
             jobs=tuple(j for j in problem.jobs if j.name in names),
             precedence=tuple((a, b) for a, b in problem.precedence if a in names),
             holding=tuple(h for h in problem.holding if h[0] in names),
             time_overrides={k: v for k, v in problem.time_overrides.items()
-                            if k[0] not in limits},
-            panels=(), name=f'{problem.name}: one panel without {", ".join(limits)}')
+                            if k[0] not in without},
+            panels=(), name=f'{problem.name}: one panel' + (
+                f' without {", ".join(sorted(without))}' if without else ''))
     except ProblemError:
         return None
 

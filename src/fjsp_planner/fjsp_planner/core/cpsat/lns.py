@@ -5,7 +5,8 @@ to improve a schedule of 60 jobs; a copy of the model where every job outside a 
 neighbourhood keeps its incumbent staffing is solved in a fraction of a second. The
 neighbourhoods relax, in turn, one or two panels, the jobs of one robot, or a window of
 consecutive jobs in time; the staffing of every other job is fixed, its times and the routes
-stay free, so a solution of the copy is a solution of the model.
+stay free, and so does the order among them except that jobs outside keep theirs; a
+solution of the copy is a solution of the model.
 """
 
 import random
@@ -81,6 +82,16 @@ def _solve_neighbourhood(model: CpsatModel, incumbent: Schedule, relaxed, second
             for index, q, lit in v.does.get((name, r), ()):
                 if not isinstance(lit, int):
                     copy.add(_same(copy, lit) == int(index == a.plan and a.robots.get(r) == q))
+    # Jobs outside the neighbourhood keep their order on each robot: an arc between two of
+    # them that are not consecutive in the incumbent stays unused (a relaxed job may still be
+    # inserted between consecutive ones). This drops most route arcs from the copy, which
+    # otherwise spends its second in presolve.
+    successor = {(a, r): b for r, route in incumbent.sequences.items()
+                 for a, b in zip(route, route[1:], strict=False)}
+    for (a, b, r), arc in model.routes.arcs.items():
+        if a in relaxed or b in relaxed or successor.get((a, r)) == b:
+            continue
+        copy.add(_same(copy, arc) == 0)
     copy.add(_same(copy, model.makespan) < model.grid.ticks(incumbent.makespan))
     copy.clear_hints()
     _hint(copy, model, incumbent)

@@ -44,6 +44,10 @@ def solve_cpsat(problem: Problem, time_limit=10.0, workers=2, hint: Schedule | N
     model.minimize_makespan()
     setup = time.monotonic() - began
     whole = deadline - time.monotonic()
+    # Neighbourhood copies of a routed model (circuits) took 2-3 s each on 5 panels, longer
+    # than CP-SAT's own neighbourhood search gains in that time: LNS only without routes.
+    if model.routes.routed:
+        lns_share = 0
     if lns_share and whole > MIN_LNS_SECONDS:
         whole *= 1 - lns_share
     solver, recorder, status = run(model.model, whole, workers, log)
@@ -58,7 +62,7 @@ def solve_cpsat(problem: Problem, time_limit=10.0, workers=2, hint: Schedule | N
     best = solver.value(model.makespan)
     bound = Fraction(math.ceil(solver.best_objective_bound), model.grid.scale)
     schedule = model.read(solver)
-    if status != 'OPTIMAL' and deadline - time.monotonic() > MIN_LNS_SECONDS:
+    if lns_share and status != 'OPTIMAL' and deadline - time.monotonic() > MIN_LNS_SECONDS:
         improved = lns.improve(model, schedule, deadline, workers, run)
         if improved.makespan < schedule.makespan:
             schedule, recorder.best = improved, time.monotonic() - began - setup
