@@ -147,10 +147,12 @@ def test_rational_travel_is_exact():
     assert result.makespan == Fraction(8, 3)
 
 
-def test_unsolvable_in_time_falls_back_to_greedy():
-    """Five panels: the greedy takes ~0.2 s of its 0.4 s share, CP-SAT needs seconds more."""
-    problem = load_scenario(PAPER, panels=5)
-    result = solve(problem, time_limit=1.0, workers=1)
+def test_a_tight_limit_still_returns_a_valid_schedule():
+    """Ten panels in 4 s: CP-SAT alone needs longer for a first schedule (6 s unloaded); the
+    greedy one (0.1-2 s, within its 1.6 s share even on a loaded machine) is returned, or
+    CP-SAT's from it."""
+    problem = load_scenario(PAPER, panels=10)
+    result = solve(problem, time_limit=4.0, workers=1)
     assert result.schedule is not None
     assert validate(problem, result.schedule) == []
 

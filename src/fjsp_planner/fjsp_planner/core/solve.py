@@ -30,6 +30,8 @@ PANEL_SHARE = 0.1
 """Share of the time limit spent, on several identical panels, on one-panel problems: the
 start stitched from their optima (`panels.stitched_schedule`) and the bound of one panel done
 without the robots that cannot move between panels (`bounds.unhelped_panel`)."""
+MIN_PANEL_SECONDS = 0.5
+"""Below this the one-panel solves' own overhead outweighs their share."""
 
 
 def solve(problem: Problem, solver: str = 'cpsat', time_limit: float = 10.0, workers: int = 2,
@@ -82,7 +84,7 @@ def solve(problem: Problem, solver: str = 'cpsat', time_limit: float = 10.0, wor
                       greedy, 'greedy', first_solution_seconds=elapsed)
     panel_bound = None
     if solver == 'cpsat' and greedy is not None and len(problem.panels) >= 2 and (
-            not problem.fixed):
+            not problem.fixed) and PANEL_SHARE * time_limit >= MIN_PANEL_SECONDS:
         stitched, panel_bound = stitched_schedule(problem, greedy.makespan,
                                                   PANEL_SHARE * time_limit, workers)
         if stitched is not None and stitched.makespan < (hint or greedy).makespan:

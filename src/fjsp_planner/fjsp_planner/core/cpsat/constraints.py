@@ -11,7 +11,7 @@ from fractions import Fraction
 from fjsp_planner.core import bounds
 from fjsp_planner.core.bounds import crossing_cost
 from fjsp_planner.core.cpsat.grid import TimeGrid
-from fjsp_planner.core.cpsat.variables import JobVariables, RouteVariables
+from fjsp_planner.core.cpsat.variables import JobVariables, RouteVariables, check
 from fjsp_planner.core.problem import Problem
 
 
@@ -26,8 +26,11 @@ def precedence(m, problem: Problem, jobs: JobVariables):
 
 
 def routes(m, problem: Problem, grid: TimeGrid, jobs: JobVariables, route: RouteVariables,
-           legs):
+           legs, deadline=None, clock=None):
     """One circuit per robot; an arc a -> b forces end_a + travel(a, b) <= start_b."""
+    by_robot = {}
+    for (a, b, owner), arc in route.arcs.items():
+        by_robot.setdefault(owner, []).append((a, b, arc))
     for robot in problem.robots:
         r = robot.name
         mine = route.nodes[r]
@@ -56,9 +59,9 @@ def routes(m, problem: Problem, grid: TimeGrid, jobs: JobVariables, route: Route
                 # end, which may lie before the release time.
                 if robot.release_time > 0:
                     m.add(jobs.start[a] >= grid.ticks(robot.release_time)).only_enforce_if(on)
-        for (a, b, owner), arc in route.arcs.items():
-            if owner != r:
-                continue
+        for count, (a, b, arc) in enumerate(by_robot.get(r, ())):
+            if count % 200 == 0:
+                check(deadline, clock)
             arcs.append((node[a], node[b], arc))
             leg = grid.ticks(legs[r, problem.job(a).location, problem.job(b).location])
             m.add(jobs.start[b] >= jobs.end[a] + leg).only_enforce_if(arc)

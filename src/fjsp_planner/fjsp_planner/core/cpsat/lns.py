@@ -18,6 +18,7 @@ from fjsp_planner.core.schedule import Schedule
 STEP_SECONDS = 1.0
 """Wall time of one neighbourhood solve: long enough to re-sequence two panels (24 jobs)."""
 WINDOW_JOBS = 16
+MIN_STEP_SECONDS = 0.5
 
 
 def improve(model: CpsatModel, incumbent: Schedule, deadline: float, workers: int,
@@ -27,7 +28,8 @@ def improve(model: CpsatModel, incumbent: Schedule, deadline: float, workers: in
     best = incumbent
     neighbourhoods = _neighbourhoods(model)
     step = 0
-    while time.monotonic() + 0.05 < deadline and neighbourhoods:
+    # A step also spends Python time copying and hinting the model: start one only with room.
+    while deadline - time.monotonic() > MIN_STEP_SECONDS and neighbourhoods:
         relaxed = neighbourhoods[step % len(neighbourhoods)](best, rng)
         step += 1
         candidate = _solve_neighbourhood(model, best, relaxed,

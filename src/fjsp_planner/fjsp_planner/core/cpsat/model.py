@@ -45,12 +45,13 @@ class CpsatModel:
         self.routes = RouteVariables(m, p, self.jobs, routed, deadline, clock)
         constraints.no_overlap(m, self.jobs)
         constraints.precedence(m, p, self.jobs)
-        constraints.routes(m, p, grid, self.jobs, self.routes, self.legs)
+        constraints.routes(m, p, grid, self.jobs, self.routes, self.legs, deadline, clock)
         constraints.holding(m, p, self.jobs, self.routes)
         self.makespan = objective.makespan(m, self.jobs, self.horizon)
         constraints.makespan_covers_work(m, p, grid, self.jobs, self.makespan)
         self.panels = constraints.panels(m, p, grid, self.jobs, self.makespan,
                                          incumbent if grid.exact else None)
+        check(deadline, clock)
 
     def minimize_makespan(self):
         self.model.minimize(self.makespan)
@@ -73,12 +74,16 @@ class CpsatModel:
              for j, a in schedule.jobs.items()},
             {r: tuple(mirror[j] for j in route) for r, route in schedule.sequences.items()})
 
-    def add_hint(self, schedule: Schedule):
+    def add_hint(self, schedule: Schedule, deadline=None):
         """Hint every variable that `schedule` determines, skipping what the problem lacks.
 
         A complete hint lets CP-SAT start from it at once instead of repairing it by search.
+        Past `deadline` (time.monotonic()) raises `OutOfTimeError`.
         """
         m, p, v, grid = self.model, self.problem, self.jobs, self.grid
+        arcs_of = {}
+        for (a, b, owner), arc in self.routes.arcs.items():
+            arcs_of.setdefault(owner, []).append((a, b, arc))
         schedule = self._respecting_symmetry(schedule)
         ends = {}
         for name, a in schedule.jobs.items():
@@ -102,6 +107,7 @@ class CpsatModel:
                     m.add_hint(lit, int(index == a.plan and robots.get(r) == q))
         panel_of = {j: k for k, names in enumerate(p.panels) for j in names}
         for r, mine in self.routes.nodes.items():
+            check(deadline, time.monotonic)
             route = [j for j in schedule.sequences.get(r, ())
                      if j in ends and r in schedule.jobs[j].robots]
             successor = dict(zip(route, route[1:], strict=False))
@@ -118,9 +124,7 @@ class CpsatModel:
                     m.add_hint(visit, int(k in stays))
                 m.add_hint(self.panels.crossings[r], sum(a != b for a, b in zip(
                     stays, stays[1:], strict=False)))
-            routes_of_r = {(a, b): arc for (a, b, owner), arc in self.routes.arcs.items()
-                           if owner == r}
-            for (a, b), arc in routes_of_r.items():
+            for a, b, arc in arcs_of.get(r, ()):
                 m.add_hint(arc, int(successor.get(a) == b))
         if len(ends) == len(v.start):
             m.add_hint(self.makespan, max(ends.values(), default=0))

@@ -36,11 +36,11 @@ def solve_cpsat(problem: Problem, time_limit=10.0, workers=2, hint: Schedule | N
     deadline = began + time_limit
     try:
         model = CpsatModel(problem, upper_bound, deadline)
+        if hint is not None or upper_bound is not None:
+            model.add_hint(hint or upper_bound, deadline)
     except OutOfTimeError:
         return Result(Status.UNKNOWN, None, None, time.monotonic() - began, None, 'cpsat',
                       notes=(f'building the CP-SAT model took the whole {time_limit:g} s',))
-    if hint is not None or upper_bound is not None:
-        model.add_hint(hint or upper_bound)
     model.minimize_makespan()
     setup = time.monotonic() - began
     whole = deadline - time.monotonic()
