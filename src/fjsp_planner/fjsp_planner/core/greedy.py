@@ -208,6 +208,11 @@ def _first_pass(problem: Problem, deadline) -> Schedule:
         return _one_pass(problem, None, deadline, QUICK)
 
 
+def quick_schedule(problem: Problem) -> Schedule:
+    """One QUICK pass: the fastest valid schedule this module makes (no deadline)."""
+    return _one_pass(problem, None, None, QUICK)
+
+
 def guided_schedule(problem: Problem, guide: Schedule, deadline: float | None = None
                     ) -> Schedule:
     """A schedule that follows `guide` (e.g. the plan a failure broke) as far as it still

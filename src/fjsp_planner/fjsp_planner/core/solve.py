@@ -100,13 +100,16 @@ def solve(problem: Problem, solver: str = 'cpsat', time_limit: float = 10.0, wor
     else:
         result = solve_cpsat(problem, remaining, workers, hint=hint, keep=keep,
                              upper_bound=hint or greedy, log=log)
-    if result.schedule is None and greedy is not None and result.status != Status.INFEASIBLE:
+    start = hint or greedy
+    if result.schedule is None and start is not None and result.status != Status.INFEASIBLE:
+        # The start is the shorter of the (valid) hint and the greedy schedule.
         elapsed = time.monotonic() - began
-        return Result(Status.FEASIBLE, greedy.makespan, critical_path_bound(problem), elapsed,
-                      greedy, 'greedy', first_solution_seconds=setup,
-                      best_solution_seconds=setup,
-                      notes=result.notes + (f'{result.solver} found no schedule in '
-                                            f'{time_limit:g} s; greedy schedule returned',))
+        which = 'greedy schedule' if start is greedy else 'starting schedule'
+        return Result(Status.FEASIBLE, start.makespan, critical_path_bound(problem), elapsed,
+                      start, 'greedy' if start is greedy else 'hint',
+                      first_solution_seconds=setup, best_solution_seconds=setup,
+                      notes=notes + result.notes + (f'{result.solver} found no schedule in '
+                                                    f'{time_limit:g} s; {which} returned',))
     result = _count_from(problem, dataclasses.replace(result, notes=notes + result.notes), setup)
     if result.schedule is not None and len(problem.panels) >= 2 and not problem.fixed:
         result = _with_panel_bounds(problem, result, panel_bound)
