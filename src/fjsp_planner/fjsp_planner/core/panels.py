@@ -33,8 +33,8 @@ def stitched_schedule(problem: Problem, incumbent: Fraction, time_limit: float, 
     first = bounds.one_panel(problem)
     if unhelped is None or first is None:
         return None, None
-    alone = solve_cpsat(unhelped, time_limit / 2, workers, lns_share=0)
-    full = solve_cpsat(first, began + time_limit - time.monotonic(), workers, lns_share=0)
+    alone = solve_cpsat(unhelped, time_limit / 2, workers)
+    full = solve_cpsat(first, began + time_limit - time.monotonic(), workers)
     if full.schedule is None or alone.schedule is None:
         return None, alone.lower_bound
     guide, offset = {}, Fraction(0)
