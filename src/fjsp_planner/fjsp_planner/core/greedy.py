@@ -3,6 +3,10 @@
 Jobs are placed one at a time, each at the assignment (plan and robots) that completes it
 earliest. A holding arc (j, j', q) is placed as one block: j, then j' straight away with j's
 type-q robots, so no other job can come between them on the holders' routes.
+
+`guided_schedule` places jobs instead in the order and with the staffing of a schedule to
+follow (a plan a failure broke, or copies of one-panel optima), wherever that is still
+possible, so that what worked before is kept and only exact times are recomputed.
 """
 
 import itertools
