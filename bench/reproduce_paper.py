@@ -343,7 +343,7 @@ def write_report(config, exact, rl, optimum, optimum_schedule, subset, wall, qui
         "with no warm start, times scaled to the exact 1/30 grid; for 2 panels also as "
         "`solve(solver='mip')` runs it, started from the greedy schedule (which also caps "
         "its horizon; its first solution is that start). CP-SAT: the project's "
-        'model (`core/cpsat.py`) through `solve()`, which warm-starts it from the greedy '
+        'model (`core/cpsat/`) through `solve()`, which warm-starts it from the greedy '
         'schedule. Gurobi 9 is not available here; its figures are quoted from the paper.',
         '',
     ]

@@ -20,7 +20,7 @@ from fjsp_planner.core.mission import (
     Settings,
     Solve,
 )
-from fjsp_planner.core.replan import replan
+from fjsp_planner.core.replan import improve, repair
 from fjsp_planner.core.scenario import load_scenario
 from fjsp_planner.core.solve import solve
 
@@ -80,17 +80,20 @@ class Fleet:
             effects += self.take(self.controller.tick(self.wall))
         return effects
 
-    def run_solves(self, effects=None):
-        """Carry out the pending solves as the node would; the effects of their outcomes."""
+    def run_solves(self, effects=None, improve_too=False):
+        """Carry out the pending solves as the node would (a search for a better plan only
+        with `improve_too`); the effects of their outcomes."""
         out = []
-        for effect in self.effects if effects is None else effects:
-            if not isinstance(effect, Solve):
+        for effect in list(self.effects if effects is None else effects):
+            if not isinstance(effect, Solve) or (effect.kind == 'improve' and not improve_too):
                 continue
             if effect.kind == 'plan':
                 outcome = solve(effect.problem, time_limit=effect.time_limit)
-            else:
-                outcome = replan(effect.problem, effect.previous, effect.state,
+            elif effect.kind == 'repair':
+                outcome = repair(effect.problem, effect.previous, effect.state,
                                  time_limit=effect.time_limit)
+            else:
+                outcome = improve(effect.published, time_limit=effect.time_limit)
             out += self.take(self.controller.solved(effect.token, outcome, self.wall))
         return out
 
@@ -189,7 +192,7 @@ def test_failure_replans_without_the_robot(problem):
     effects = fleet.report('MARC1', RobotMode.FAILED)
     assert notes(effects, MissionEventKind.ROBOT_FAILED)
     (request,) = kinds(fleet.tick(), Solve)
-    assert request.kind == 'replan' and "robot 'MARC1' failed" in request.reasons
+    assert request.kind == 'repair' and "robot 'MARC1' failed" in request.reasons
     assert not request.state.robots['MARC1'].healthy
     (published,) = kinds(fleet.run_solves(), PublishPlan)
     assert published.revision == 2 and 'MARC1' not in published.result.schedule.sequences
@@ -448,3 +451,38 @@ def test_resume_rebuilds_the_mission_and_replans_above_what_robots_follow(proble
     # Done jobs are not redone (a done jig job may go on, continued, while its hold lasts).
     restarted_jobs = set(published.result.schedule.jobs) - published.continued
     assert not restarted_jobs & set(mission.tracker.done)
+
+
+def test_a_repaired_plan_is_published_at_once_then_bettered(problem):
+    fleet = executing(problem)
+    fleet.wall += 2
+    fleet.execute(until=2)
+    fleet.failures['MARC1'] += 1
+    fleet.report('MARC1', RobotMode.FAILED)
+    (repair_request,) = kinds(fleet.tick(), Solve)
+    effects = fleet.run_solves([repair_request])
+    (repaired,) = kinds(effects, PublishPlan)
+    searches = [e for e in kinds(effects, Solve) if e.kind == 'improve']
+    if repaired.result.status == 'optimal':
+        assert not searches  # nothing to better
+        return
+    (search,) = searches
+    better = kinds(fleet.run_solves([search], improve_too=True), PublishPlan)
+    for plan in better:
+        assert plan.revision == repaired.revision + 1
+        assert plan.result.makespan < repaired.result.makespan
+        assert plan.reasons[0].startswith('a better plan: makespan')
+
+
+def test_a_search_for_a_better_plan_is_dropped_when_the_fleet_changes(problem):
+    fleet = executing(problem)
+    fleet.failures['MARC1'] += 1
+    fleet.report('MARC1', RobotMode.FAILED)
+    (repair_request,) = kinds(fleet.tick(), Solve)
+    searches = [e for e in kinds(fleet.run_solves([repair_request]), Solve)
+                if e.kind == 'improve']
+    fleet.failures['MARC2'] += 1
+    fleet.report('MARC2', RobotMode.FAILED)
+    assert kinds(fleet.tick(), Solve)  # a new repair for the second failure
+    for search in searches:
+        assert not fleet.run_solves([search], improve_too=True)

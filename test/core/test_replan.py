@@ -26,6 +26,8 @@ from fjsp_planner.core.replan import (
     ExecutionState,
     RobotState,
     StateError,
+    improve,
+    repair,
     replan,
     residual_problem,
     simulated_state,
@@ -405,3 +407,38 @@ BAD_STATES = [
 def test_bad_state_is_named(small, why, change, message):
     with pytest.raises(StateError, match=message):
         residual_problem(small, change(at(small, Fraction(5, 2))), PLAN)
+
+
+@pytest.mark.parametrize(('now', 'failed', 'makespan', 'why'), HAND_CHECKED,
+                         ids=[row[3].split(':')[0] for row in HAND_CHECKED])
+def test_repair_then_improve_reaches_the_hand_computed_makespan(small, now, failed, makespan,
+                                                                 why):
+    """Anytime re-planning: `repair` publishes a valid plan without search, `improve` then
+    reaches the optimum and says whether it is worth a new revision."""
+    state = at(small, now, failed)
+    repaired = repair(small, PLAN, state)
+    assert repaired.problems == []
+    assert repaired.schedule.makespan >= makespan
+    better = improve(repaired, time_limit=5.0)
+    assert better.replan.problems == []
+    assert validate(better.replan.residual.problem, better.replan.schedule) == []
+    assert better.replan.schedule.makespan == makespan
+    assert better.improved == (makespan < repaired.schedule.makespan * Fraction(98, 100))
+
+
+def test_improve_keeps_the_published_plan_for_a_small_gain(small):
+    """A margin of 100 % can never be beaten: the published plan stays, unchanged."""
+    repaired = repair(small, PLAN, at(small, 1, {'B'}))
+    kept = improve(repaired, time_limit=2.0, margin=1.0)
+    assert not kept.improved
+    assert kept.replan.schedule == repaired.schedule
+
+
+def test_repair_keeps_the_previous_plan_when_it_still_works(paper):
+    """A robot failing after its last job leaves the rest of the optimal plan valid."""
+    problem, plan = paper
+    last = {r: plan.jobs[seq[-1]].end for r, seq in plan.sequences.items() if seq}
+    robot = min(last, key=last.get)
+    repaired = repair(problem, plan, simulated_state(problem, plan, last[robot] + 1, {robot}))
+    assert repaired.problems == []
+    assert repaired.schedule.makespan == 32

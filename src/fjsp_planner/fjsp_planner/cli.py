@@ -17,13 +17,13 @@ import threading
 from fractions import Fraction
 from pathlib import Path
 
+from fjsp_planner.core.limits import MAX_WORKERS
 from fjsp_planner.core.problem import ProblemError
 from fjsp_planner.core.schedule import Result
 from fjsp_planner.core.validate import validate
 
 EXIT_BAD_INPUT = 2
 EXIT_INVALID_SCHEDULE = 3
-MAX_WORKERS = 64
 
 _stage = 'starting'
 """What the worker is doing, for the message of an interruption."""
@@ -54,9 +54,9 @@ def main(argv=None) -> int:
 
 def _interrupted(signum, frame):
     name = signal.Signals(signum).name
-    sys.stdout.flush()
-    sys.stderr.write(f'fjsp-solve: stopped by {name} while {_stage}\n')
-    sys.stderr.flush()
+    # Straight to the file descriptor: the worker may hold a stream's lock mid-write, and a
+    # handler waiting for it would not stop at once.
+    os.write(2, f'fjsp-solve: stopped by {name} while {_stage}\n'.encode())
     # Exit at once, whatever the worker thread (maybe inside CP-SAT) is doing.
     os._exit(128 + signum)
 

@@ -39,6 +39,9 @@ MAX_ROUTING_ARCS = 1_500_000
 """Sum over robots of (jobs it could take part in)^2: the paper's fleet at 50 panels."""
 MAX_NAME_LENGTH = 100
 MAX_FILE_BYTES = 4 * 2**20
+MAX_WORKERS = 64
+"""More search workers than this only thrash on any machine the fleet's planner runs on, and
+CP-SAT rejects absurd counts with an opaque "model invalid"."""
 
 _show = reprlib.Repr()
 _show.maxstring = _show.maxother = 60

@@ -25,9 +25,13 @@ from fjsp_common.vocabulary import EventKind, MissionEventKind, MissionState, Ro
 from fjsp_planner.core.journal import DoneRecord, PlanRecord, Record
 from fjsp_planner.core.problem import Problem
 from fjsp_planner.core.replan import ExecutionState, Replan, RobotState, residual_problem
-from fjsp_planner.core.schedule import JobAssignment, Result, Schedule
+from fjsp_planner.core.schedule import JobAssignment, Result, Schedule, Status
 from fjsp_planner.core.tracking import Ignored, MissionTracker
 from fjsp_planner.core.validate import validate
+
+REPAIR_LIMIT = 0.5
+"""Seconds the repair of a plan may take: a valid plan of what remains without search (a few
+hundred ms on 5 panels), published at once; the search for a better one follows."""
 
 CATCH_UP = 0.5
 """Seconds a resumed mission waits, once every robot's event writer is matched, for their
@@ -90,7 +94,9 @@ class EventReport:
 class Solve:
     """Run a solve off the executor and hand its outcome to `MissionController.solved`.
 
-    kind 'plan': `solve(problem)`; kind 'replan': `replan(problem, previous, state)`."""
+    kind 'plan': `solve(problem)`; kind 'repair': `repair(problem, previous, state)`, a valid
+    plan of what remains at once, without search; kind 'improve': `improve(published)`, a
+    search from the plan just published."""
 
     token: int
     kind: str
@@ -100,6 +106,8 @@ class Solve:
     state: ExecutionState | None = None
     reasons: tuple[str, ...] = ()
     """Why a re-plan is needed."""
+    published: Replan | None = None
+    """For 'improve': the repaired plan to search from."""
 
 
 @dataclass(frozen=True)
@@ -209,6 +217,8 @@ class _Mission:
     warned: set[str] = field(default_factory=set)
     pending: tuple[str, ...] = ()
     """Reasons of a re-plan still to make (one discarded, jobs added, a restart)."""
+    improving: _Solving | None = None
+    """The search for a better plan than the repaired one in force, if any."""
     blocked_too_long: bool = False
     resumed: bool = False
     """Rebuilt after a planner restart: re-planned once the fleet has caught it up."""
@@ -244,7 +254,7 @@ class MissionController:
         mission = self.mission
         if mission is None or mission.state.ended:
             raise ValueError('no mission is running')
-        mission.solving = None
+        mission.solving = mission.improving = None
         mission.state = MissionState.CANCELLED
         mission.failure = (reason,)
         effects: list[Effect] = [Note(MissionEventKind.MISSION_CANCELLED, (reason,))]
@@ -265,6 +275,7 @@ class MissionController:
         mission.tracker.extend(problem)
         reason = 'jobs added: ' + ', '.join(jobs)
         effects: list[Effect] = [Note(MissionEventKind.JOBS_ADDED, job=', '.join(jobs))]
+        mission.improving = None
         if mission.solving is not None:
             # Whatever is being solved leaves the new jobs out.
             mission.solving = None
@@ -536,8 +547,10 @@ class MissionController:
         state = replace(state, robots={name: replace(robot, healthy=name in fleet)
                                        for name, robot in state.robots.items()})
         mission.state = MissionState.REPLANNING
-        return [self._solve(mission, 'replan', fleet, reasons, mission.problem,
-                            mission.settings.replan_time_limit, mission.schedule, state)]
+        mission.improving = None  # a search from an older state would only be discarded
+        limit = min(REPAIR_LIMIT, mission.settings.replan_time_limit)
+        return [self._solve(mission, 'repair', fleet, reasons, mission.problem, limit,
+                            mission.schedule, state)]
 
     def _solve(self, mission, kind, fleet, reasons, problem, time_limit, previous=None,
                state=None) -> Solve:
@@ -545,10 +558,22 @@ class MissionController:
         mission.solving = _Solving(self._tokens, kind, problem, fleet, reasons, state)
         return Solve(self._tokens, kind, problem, time_limit, previous, state, reasons)
 
+    def _improve(self, mission, solving: _Solving, published: Replan) -> Solve:
+        """Search for a better plan from the one just published, while it is followed."""
+        self._tokens += 1
+        mission.improving = replace(solving, token=self._tokens, kind='improve')
+        return Solve(self._tokens, 'improve', published.residual.problem,
+                     mission.settings.replan_time_limit, state=solving.state,
+                     reasons=solving.reasons, published=published)
+
     def solved(self, token: int, outcome, wall: float) -> list[Effect]:
         """The outcome of `Solve` `token`: a `Result` ('plan'), a `Replan` ('replan'), or
         the ValueError the solver raised. Outcomes of superseded solves are dropped."""
         mission = self.mission
+        if mission is not None and mission.improving is not None \
+                and mission.improving.token == token:
+            improving, mission.improving = mission.improving, None
+            return self._improved(mission, improving, outcome, wall)
         if mission is None or mission.solving is None or mission.solving.token != token:
             return []
         solving, mission.solving = mission.solving, None
@@ -624,8 +649,30 @@ class MissionController:
         notes = [Note(MissionEventKind.JOB_VOIDED, ('its hold was lost',), job=job)
                  for job in residual.voided]
         mission.blocked, mission.blocked_since = (), None
-        return notes + self._publish(mission, residual.problem, result,
-                                     continued | frozenset(progressed), solving.reasons)
+        published = self._publish(mission, residual.problem, result,
+                                  continued | frozenset(progressed), solving.reasons)
+        if result.status == Status.OPTIMAL:
+            return notes + published
+        return notes + published + [self._improve(mission, solving, replanned)]
+
+    def _improved(self, mission, solving: _Solving, outcome, wall: float) -> list[Effect]:
+        """A better plan than the repaired one, published as the next revision if it beats
+        it by the improvement margin, nothing changed in the fleet meanwhile, and what the
+        robots did since goes on as it is in it."""
+        if isinstance(outcome, Exception) or not outcome.improved \
+                or mission.state != MissionState.EXECUTING:
+            return []
+        if self._fleet(mission, self._unavailable(mission, wall)) != solving.fleet:
+            return []
+        better = outcome.replan
+        continued = frozenset(better.residual.problem.fixed)
+        progressed = self._progressed(mission, solving.state, better.residual.problem)
+        if progressed and not self._goes_on(mission, better.schedule, progressed, continued):
+            return []
+        reason = (f'a better plan: makespan {mission.planned_makespan:.2f} -> '
+                  f'{float(better.result.makespan):.2f}')
+        return self._publish(mission, better.residual.problem, better.result,
+                             continued | frozenset(progressed), (reason,))
 
     def _progressed(self, mission, posed_state: ExecutionState, posed: Problem) -> list[str]:
         """Jobs the new plan starts afresh that started or completed since it was posed."""

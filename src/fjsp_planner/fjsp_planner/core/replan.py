@@ -22,13 +22,22 @@ robot may come back, and a later state then gives a solvable residual. Holds tha
 schedule at all (each holder waiting for the other's held job) are given up by `replan`.
 """
 
+import dataclasses
+import time
 from collections import Counter
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from fractions import Fraction
 
+from fjsp_planner.core.bounds import critical_path_bound
+from fjsp_planner.core.greedy import (
+    GreedyOutOfTimeError,
+    GreedyStuckError,
+    guided_schedule,
+    quick_schedule,
+)
 from fjsp_planner.core.problem import FixedJob, Job, Problem, Robot, max_staffed
-from fjsp_planner.core.schedule import JobAssignment, Result, Schedule
+from fjsp_planner.core.schedule import JobAssignment, Result, Schedule, Status
 from fjsp_planner.core.solve import solve
 from fjsp_planner.core.validate import validate
 
@@ -132,13 +141,114 @@ def replan(problem: Problem, previous: Schedule, state: ExecutionState, time_lim
 
 
 def _solve(residual: Problem, previous: Schedule, time_limit, workers) -> Result:
-    """Solve, keeping close to `previous`, and starting from it if it still works.
+    """Solve, keeping close to `previous`, and starting from the best of what it suggests.
 
     A previous plan broken by the failure is a poor start: CP-SAT repairing its stale parts
-    can take longer than finding a schedule afresh from the greedy one.
+    can take longer than finding a schedule afresh. So the search starts from `previous`
+    restricted to what remains if that still works, else from a schedule that follows it
+    where it can (`guided_schedule`), whichever is shorter; `solve` adds the greedy one.
     """
-    return solve(residual, time_limit=time_limit, workers=workers,
-                 hint=_project(residual, previous), keep=previous)
+    began = time.monotonic()
+    start = _starts(residual, previous, began + GUIDE_SHARE * time_limit)
+    return solve(residual, time_limit=max(0.05, time_limit - (time.monotonic() - began)),
+                 workers=workers, hint=start[0] if start else None, keep=previous)
+
+
+GUIDE_SHARE = 0.5
+"""Share of a re-plan's time limit the schedule following the previous plan may take: on 5
+panels it is usually the re-plan (CP-SAT rarely improves on it in the rest of 0.7 s), and a
+quarter of the limit was too little for it on a loaded machine."""
+
+
+def _starts(residual: Problem, previous: Schedule, deadline) -> list[Schedule]:
+    """Valid schedules of `residual` suggested by `previous`, shortest first."""
+    found = []
+    projected = _project(residual, previous)
+    if projected is not None and not validate(residual, projected):
+        found.append(projected)
+    try:
+        guided = guided_schedule(residual, previous, deadline)
+    except (GreedyStuckError, GreedyOutOfTimeError):
+        guided = None
+    if guided is not None and not validate(residual, guided):
+        found.append(guided)
+    return sorted(found, key=lambda schedule: schedule.makespan)
+
+
+def repair(problem: Problem, previous: Schedule, state: ExecutionState,
+           time_limit: float = 0.5) -> Replan:
+    """A valid plan of what remains, at once: the first stage of anytime re-planning.
+
+    The shortest of the previous plan restricted to what remains (when that still works), a
+    schedule following it where it can (`guided_schedule`) and the greedy schedule, without
+    any search: publish it, then call `improve`. Holds that deadlock are given up as in
+    `replan`. `time_limit` bounds the heuristics (a 5-panel residual takes ~0.2 s); should
+    none finish in it, a quick greedy pass (~20 ms on 5 panels) is waited for.
+    """
+    began = time.monotonic()
+    residual = residual_problem(problem, state, previous)
+    if residual.problem is None:
+        return Replan(residual, None, [])
+    starts = _starts(residual.problem, previous, began + time_limit / 2)
+    result = solve(residual.problem, solver='greedy',
+                   time_limit=max(0.05, began + time_limit - time.monotonic()))
+    holding = {a for a, _, _ in residual.problem.holding if a in residual.problem.fixed}
+    if result.schedule is None and not starts and holding:
+        residual = residual_problem(problem, state, previous, release=holding)
+        if residual.problem is None:
+            return Replan(residual, None, [])
+        starts = _starts(residual.problem, previous, began + time_limit)
+        result = solve(residual.problem, solver='greedy', time_limit=time_limit)
+    if result.schedule is None and not starts:
+        try:
+            starts = [quick_schedule(residual.problem)]
+        except GreedyStuckError:
+            starts = []
+    if starts and (result.schedule is None or starts[0].makespan < result.schedule.makespan):
+        result = Result(Status.FEASIBLE, starts[0].makespan,
+                        critical_path_bound(residual.problem), time.monotonic() - began,
+                        starts[0], 'greedy', notes=('follows the previous plan where it can',))
+    problems = [] if result.schedule is None else validate(residual.problem, result.schedule)
+    return Replan(residual, result, problems)
+
+
+@dataclass(frozen=True)
+class Improvement:
+    replan: Replan
+    """The better plan (or the published one, unchanged), on the same residual problem."""
+    improved: bool
+    """The new plan is shorter than the published one by more than `margin`: worth a new
+    revision. False keeps agents on the published plan rather than thrash for a few %."""
+
+
+IMPROVE_MARGIN = 0.02
+
+
+def improve(published: Replan, time_limit: float = 2.0, workers: int = 2,
+            margin: float = IMPROVE_MARGIN) -> Improvement:
+    """The second stage of anytime re-planning: search from the published plan.
+
+    CP-SAT starts from `published` (a `repair` or earlier `improve` outcome) and, among the
+    shortest schedules it finds, prefers those moving the fewest robots off it. `improved`
+    says whether the result beats the published makespan by more than `margin` (a share).
+    The residual problem is the published one's, posed at the failure's time: jobs the
+    agents finished meanwhile stay in it, so re-pose with `repair` before publishing if the
+    mission moved on far.
+    """
+    residual = published.residual
+    if residual.problem is None or published.schedule is None:
+        return Improvement(published, False)
+    result = solve(residual.problem, time_limit=time_limit, workers=workers,
+                   hint=published.schedule, keep=published.schedule)
+    if result.schedule is None or validate(residual.problem, result.schedule):
+        return Improvement(published, False)
+    better = result.makespan < published.schedule.makespan * (1 - Fraction(margin))
+    if not better:
+        # Same plan, but the search may have proven it optimal: keep its bound.
+        kept = dataclasses.replace(published.result, lower_bound=max(
+            published.result.lower_bound or 0, result.lower_bound or 0))
+        return Improvement(Replan(residual, kept, published.problems), False)
+    return Improvement(Replan(residual, result, []), True)
 
 
 def _project(residual: Problem, previous: Schedule) -> Schedule | None:

@@ -4,13 +4,32 @@ import dataclasses
 import time
 from fractions import Fraction
 
+from fjsp_planner.core import bounds
+from fjsp_planner.core.bounds import critical_path_bound
 from fjsp_planner.core.cpsat import solve_cpsat
-from fjsp_planner.core.greedy import GreedyStuckError, greedy_schedule
+from fjsp_planner.core.greedy import (
+    GreedyOutOfTimeError,
+    GreedyStuckError,
+    greedy_schedule,
+)
+from fjsp_planner.core.limits import MAX_WORKERS
+from fjsp_planner.core.panels import stitched_schedule
 from fjsp_planner.core.problem import Problem
 from fjsp_planner.core.schedule import Result, Schedule, Status
 from fjsp_planner.core.validate import validate
 
 SOLVERS = ('cpsat', 'greedy', 'mip')
+GREEDY_SHARE = 0.4
+"""Share of the time limit the greedy schedule may take before the exact solver starts."""
+GREEDY_PASSES_SHARE = 0.02
+"""Share of the time limit for randomised greedy passes after the first: a better start for
+CP-SAT on classic FJSP files (where the first pass is often 20-30 % above the best known)."""
+PANEL_SHARE = 0.1
+"""Share of the time limit spent, on several identical panels, on one-panel problems: the
+start stitched from their optima (`panels.stitched_schedule`) and the bound of one panel done
+without the robots that cannot move between panels (`bounds.unhelped_panel`)."""
+MIN_PANEL_SECONDS = 0.5
+"""Below this the one-panel solves' own overhead outweighs their share."""
 
 
 def solve(problem: Problem, solver: str = 'cpsat', time_limit: float = 10.0, workers: int = 2,
@@ -22,28 +41,53 @@ def solve(problem: Problem, solver: str = 'cpsat', time_limit: float = 10.0, wor
     only) then prefers, among schedules of the proven best makespan, those that change the
     fewest of its (job, robot) assignments. The greedy schedule bounds the horizon and is
     returned when an exact solver finds nothing in time.
+
+    The whole call (greedy, model building, solving, keeping assignments) takes at most
+    `time_limit` seconds, plus the solver's reaction time to its own limit (milliseconds),
+    for problems up to the size limit of the scenario checks (about 1000 jobs). `workers`
+    must lie in 1..MAX_WORKERS.
     """
     if solver not in SOLVERS:
         raise ValueError(f"unknown solver '{solver}'; choose one of {', '.join(SOLVERS)}")
+    if isinstance(workers, bool) or not isinstance(workers, int) or not (
+            1 <= workers <= MAX_WORKERS):
+        raise ValueError(f'workers must be an integer from 1 to {MAX_WORKERS}, got {workers!r}')
+    if not time_limit > 0:
+        raise ValueError(f'time_limit must be a positive number of seconds, got {time_limit!r}')
     began = time.monotonic()
     notes = ()
     if hint is not None and validate(problem, hint):
         # Repairing a broken hint can cost CP-SAT more than starting from the greedy one.
         hint, notes = None, ('the hint is not a valid schedule of this problem; ignored',)
+    greedy_time = time_limit if solver == 'greedy' else GREEDY_SHARE * time_limit
     try:
-        greedy = greedy_schedule(problem)
+        greedy = greedy_schedule(problem, deadline=began + greedy_time,
+                                 time_budget=max(0.15, GREEDY_PASSES_SHARE * time_limit))
     except GreedyStuckError:
         greedy = None
+    except GreedyOutOfTimeError:
+        greedy, notes = None, notes + (f'no greedy schedule within {greedy_time:g} s',)
     if greedy is not None and validate(problem, greedy):
         # Its makespan would cap the horizon; an invalid one could make CP-SAT miss schedules.
         greedy, notes = None, notes + ('the greedy schedule was invalid; not used',)
+    if hint is not None and greedy is not None and greedy.makespan < hint.makespan:
+        # The horizon comes from the shorter one, and would cut the longer hint off.
+        hint = greedy
     if solver == 'greedy':
         if greedy is None:
             return Result(Status.UNKNOWN, None, None, time.monotonic() - began, None, 'greedy',
-                          notes=('greedy scheduling got stuck; try an exact solver',))
+                          notes=notes or ('greedy scheduling got stuck; try an exact solver',))
         elapsed = time.monotonic() - began
         return Result(Status.FEASIBLE, greedy.makespan, critical_path_bound(problem), elapsed,
                       greedy, 'greedy', first_solution_seconds=elapsed)
+    panel_bound = None
+    if solver == 'cpsat' and greedy is not None and len(problem.panels) >= 2 and (
+            not problem.fixed) and PANEL_SHARE * time_limit >= MIN_PANEL_SECONDS:
+        stitched, panel_bound = stitched_schedule(problem, greedy.makespan,
+                                                  PANEL_SHARE * time_limit, workers)
+        if stitched is not None and stitched.makespan < (hint or greedy).makespan:
+            hint, notes = stitched, notes + ('started from panels stitched from one-panel '
+                                             'optima',)
     setup = time.monotonic() - began
     remaining = max(0.05, time_limit - setup)
     if solver == 'mip':
@@ -53,15 +97,38 @@ def solve(problem: Problem, solver: str = 'cpsat', time_limit: float = 10.0, wor
                            hint=hint or greedy, log=log)
     else:
         result = solve_cpsat(problem, remaining, workers, hint=hint, keep=keep,
-                             upper_bound=greedy, log=log)
-    if result.schedule is None and greedy is not None and result.status != Status.INFEASIBLE:
+                             upper_bound=hint or greedy, log=log)
+    start = hint or greedy
+    if result.schedule is None and start is not None and result.status != Status.INFEASIBLE:
+        # The start is the shorter of the (valid) hint and the greedy schedule.
         elapsed = time.monotonic() - began
-        return Result(Status.FEASIBLE, greedy.makespan, critical_path_bound(problem), elapsed,
-                      greedy, 'greedy', first_solution_seconds=setup,
-                      best_solution_seconds=setup,
-                      notes=result.notes + (f'{result.solver} found no schedule in '
-                                            f'{time_limit:g} s; greedy schedule returned',))
-    return _count_from(problem, dataclasses.replace(result, notes=notes + result.notes), setup)
+        which = 'greedy schedule' if start is greedy else 'starting schedule'
+        return Result(Status.FEASIBLE, start.makespan, critical_path_bound(problem), elapsed,
+                      start, 'greedy' if start is greedy else 'hint',
+                      first_solution_seconds=setup, best_solution_seconds=setup,
+                      notes=notes + result.notes + (f'{result.solver} found no schedule in '
+                                                    f'{time_limit:g} s; {which} returned',))
+    result = _count_from(problem, dataclasses.replace(result, notes=notes + result.notes), setup)
+    if result.schedule is not None and len(problem.panels) >= 2 and not problem.fixed:
+        result = _with_panel_bounds(problem, result, panel_bound)
+    return result
+
+
+def _with_panel_bounds(problem: Problem, result: Result, unhelped: Fraction | None) -> Result:
+    """The result with its bound raised by the panel decomposition bounds (bounds.py);
+    `unhelped` is the proven bound of one panel without the slow robots, if known."""
+    best = result.makespan
+    found = [b for b in (bounds.panel_energy_bound(problem, best),
+                         bounds.panel_clique_bound(problem, best), unhelped) if b is not None]
+    if not found:
+        return result
+    raised = min(max(result.lower_bound or 0, *found), best)
+    if raised <= (result.lower_bound or 0):
+        return result
+    return dataclasses.replace(
+        result, lower_bound=raised,
+        status=Status.OPTIMAL if raised >= best else result.status,
+        notes=result.notes + (f'bound raised to {float(raised):g} by panel decomposition',))
 
 
 def _count_from(problem: Problem, result: Result, setup: float) -> Result:
@@ -70,39 +137,13 @@ def _count_from(problem: Problem, result: Result, setup: float) -> Result:
     def shifted(seconds):
         return None if seconds is None else seconds + setup
 
-    bound = result.lower_bound
+    bound, status = result.lower_bound, result.status
     if bound is not None:
-        bound = min(max(bound, critical_path_bound(problem)), result.makespan)
+        path = critical_path_bound(problem)
+        bound = min(max(bound, path), result.makespan)
+        if path >= result.makespan:
+            status = Status.OPTIMAL
     return dataclasses.replace(
-        result, lower_bound=bound, solve_seconds=result.solve_seconds + setup,
+        result, status=status, lower_bound=bound, solve_seconds=result.solve_seconds + setup,
         first_solution_seconds=shifted(result.first_solution_seconds),
         best_solution_seconds=shifted(result.best_solution_seconds))
-
-
-def critical_path_bound(problem: Problem) -> Fraction:
-    """Longest precedence chain, each job at its fastest possible duration."""
-    fastest = {}
-    for job in problem.jobs:
-        fixed = problem.fixed.get(job.name)
-        if fixed is not None:
-            fastest[job.name] = fixed.end - fixed.start
-            continue
-        per_plan = []
-        for plan in job.plans:
-            times = [min((t for r in problem.robots
-                          if (t := problem.duration(r.name, q)) is not None),
-                         default=Fraction(0)) for q in plan]
-            per_plan.append(max(times))
-        fastest[job.name] = min(per_plan)
-    starts = {job.name: Fraction(0) for job in problem.jobs}
-    for name, fixed in problem.fixed.items():
-        starts[name] = fixed.start
-    ends = {}
-
-    def end(name):
-        if name not in ends:
-            ready = max((end(a) for a in problem.predecessors(name)), default=starts[name])
-            ends[name] = max(ready, starts[name]) + fastest[name]
-        return ends[name]
-
-    return max((end(j.name) for j in problem.jobs), default=Fraction(0))

@@ -74,7 +74,7 @@ from fjsp_planner.core.mission import (
     Solve,
 )
 from fjsp_planner.core.problem import ProblemError
-from fjsp_planner.core.replan import replan
+from fjsp_planner.core.replan import improve, repair
 from fjsp_planner.core.scenario import load_scenario, scenario_from_text
 from fjsp_planner.core.solve import SOLVERS, solve
 from fjsp_planner.core.tracking import Ignored
@@ -207,8 +207,9 @@ class PlannerNode(Node):
         self.event_count = 0
         self.incarnation = self.auth.signer.incarnation
         self.solves: dict[int, Future] = {}
-        # One worker thread: the solve runs there so the executor keeps serving callbacks.
-        self.pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix='solver')
+        # Solves run off the executor so it keeps serving callbacks; two, so that a repair
+        # need not wait for the search for a better plan it makes obsolete.
+        self.pool = ThreadPoolExecutor(max_workers=2, thread_name_prefix='solver')
         self.solved_guard = self.create_guard_condition(self.collect_solves)
 
         self.plan_pub = self.create_publisher(Plan, PLAN_TOPIC, LATCHED_QOS)
@@ -574,14 +575,16 @@ class PlannerNode(Node):
                                    f'{request.time_limit:g} s, {workers} workers')
             future = self.pool.submit(solve, request.problem, solver=self.solver,
                                       time_limit=request.time_limit, workers=workers)
-        else:
+        elif request.kind == 'repair':
             self.replan_began = time.monotonic()
             now = self.controller.now_units(self.wall())
             self.get_logger().warning(f're-planning at t={now:.2f}: '
                                       + shorten('; '.join(request.reasons), 2000))
-            future = self.pool.submit(replan, request.problem, request.previous,
-                                      request.state, time_limit=request.time_limit,
-                                      workers=workers)
+            future = self.pool.submit(repair, request.problem, request.previous,
+                                      request.state, time_limit=request.time_limit)
+        else:
+            future = self.pool.submit(improve, request.published,
+                                      time_limit=request.time_limit, workers=workers)
         self.solves[request.token] = future
         future.add_done_callback(lambda _: self.solved_guard.trigger())
 
@@ -592,7 +595,9 @@ class PlannerNode(Node):
             del self.solves[token]
             try:
                 outcome = future.result()
-            except ValueError as error:
+            except Exception as error:  # noqa: BLE001  a solver's fault must not stop the fleet
+                self.get_logger().error(f'solve failed: {type(error).__name__}: '
+                                        f'{shorten(str(error), 500)}')
                 outcome = error
             self.carry_out(self.controller.solved(token, outcome, self.wall()))
 
