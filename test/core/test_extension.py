@@ -85,3 +85,13 @@ def test_bad_fragments(problem, text, reason):
     with pytest.raises(ProblemError) as error:
         extend(problem, text)
     assert any(reason in p for p in error.value.problems), error.value.problems
+
+
+def test_the_shipped_second_panel_fragment_makes_two_panels(problem):
+    """config/fragments/solar_panel_second_panel.yaml: the README's `mission add` example."""
+    fragment = SCENARIO.parents[1] / 'fragments' / 'solar_panel_second_panel.yaml'
+    extended, added = extend(problem, fragment.read_text())
+    two = load_scenario(SCENARIO, panels=2)
+    assert len(added) == 12 and len(extended.jobs) == len(two.jobs) == 24
+    # The same instance as two panels repeated, but for the first panel's names.
+    assert sorted(extended.distances.values()) == sorted(two.distances.values())

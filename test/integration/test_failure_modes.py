@@ -91,3 +91,16 @@ def test_no_robot_is_declared_offline_in_a_quiet_mission(fjsp_fleet):
     assert observer.status.plan_revision == 1
     done = [e for e in observer.events if e.kind == TaskEvent.KIND_JOB_DONE]
     assert len(done) == 12
+
+
+def test_jobs_done_while_replanning_are_not_done_again(fjsp_fleet):
+    """Five panels at 0.01 s per unit: a re-plan takes long in schedule time, and robots
+    finish jobs of the old plan while it is computed. None may be done a second time."""
+    fleet = fjsp_fleet(SCENARIO, panels=5, time_scale=0.01,
+                       planner={'time_limit': 10.0, 'replan_time_limit': 2.5}).start()
+    fleet.wait_for(lambda o: o.status is not None and o.status.jobs_done >= 20, 180,
+                   '20 of 60 jobs done')
+    fleet.inject_fault('MARC1', 'fail')
+    fleet.wait_for(lambda o: o.latest_revision() >= 2, 60, 'a re-plan without MARC1')
+    fleet.inject_fault('MARC1', 'recover')
+    fleet.check_mission_complete(timeout=300)

@@ -121,24 +121,10 @@ def test_cancel_leaves_the_fleet_idle_for_the_next_mission(client, observer):
     check_done_once(load_scenario(SCENARIO), observer, third.mission_id)
 
 
-def second_panel(problem, shift=60) -> str:
-    """The fragment adding a copy of `problem`'s jobs `shift` away: a second panel."""
-    tag = '{}_2'.format
-    locations = problem.locations()
-    pairs = [[tag(a), tag(b), str(problem.distance(a, b))]
-             for i, a in enumerate(locations) for b in locations[i + 1:]]
-    pairs += [[tag(a), b, str(problem.distance(a, b) + shift)]
-              for a in locations for b in locations]
-    return yaml.safe_dump({
-        'jobs': [{'name': tag(j.name), 'location': tag(j.location),
-                  'plans': [list(p) for p in j.plans]} for j in problem.jobs],
-        'distances': {'pairs': pairs},
-        'precedence': [[tag(a), tag(b)] for a, b in problem.precedence],
-        'holding': [[tag(a), tag(b), q] for a, b, q in problem.holding]})
+SECOND_PANEL = SCENARIO.parents[1] / 'fragments' / 'solar_panel_second_panel.yaml'
 
 
 def test_a_second_panel_added_mid_mission(client, observer):
-    problem = load_scenario(SCENARIO)
     mission = client.submit(SCENARIO)
     observer.wait_for(lambda o: o.status is not None
                       and o.status.mission_id == mission.mission_id
@@ -147,7 +133,7 @@ def test_a_second_panel_added_mid_mission(client, observer):
         client.add_jobs(fragment_yaml=yaml.safe_dump({'jobs': [{'name': 'X', 'plans': [[0]]}],
                                                      'precedence': [['X', 'Nowhere']]}))
     assert any('Nowhere' in p for p in bad.value.problems), bad.value.problems
-    added = client.add_jobs(fragment_yaml=second_panel(problem))
+    added = client.add_jobs(SECOND_PANEL)
     assert len(added) == 12
     result = mission.result(timeout=120)
     assert result.complete and (result.jobs_done, result.jobs_total) == (24, 24), result
@@ -155,7 +141,7 @@ def test_a_second_panel_added_mid_mission(client, observer):
     extended = load_scenario(SCENARIO, panels=1)
     from fjsp_planner.core.extension import extend
 
-    extended, _ = extend(extended, second_panel(problem))
+    extended, _ = extend(extended, SECOND_PANEL.read_text())
     check_done_once(extended, observer, mission.mission_id)
 
 

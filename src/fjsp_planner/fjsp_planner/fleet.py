@@ -34,12 +34,11 @@ from ament_index_python.packages import get_package_prefix
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 
 from fjsp_common.auth import KEY_FILE_VARIABLE, new_key
-from fjsp_common.contract import LATCHED_QOS, MISSION_STATUS_TOPIC
+from fjsp_common.contract import LATCHED_QOS, MISSION_STATUS_TOPIC, agent_node_name
 from fjsp_msgs.msg import MissionStatus
 from fjsp_planner.core.problem import Problem, ProblemError
 from fjsp_planner.core.scenario import load_scenario
 from fjsp_planner.workspace import default_out_dir, installed_scenarios
-from robot_agents.agent_node import agent_node_name
 
 PLANNER_NODE = 'planner'
 MONITOR_NODE = 'monitor'

@@ -185,8 +185,10 @@ class FleetHarness(Fleet):
                       "every job-done event and every robot's operation reports")
         with self.observer.lock:
             plans, events = list(self.observer.plans), list(self.observer.events)
+            story = list(self.observer.mission_events)
             status = self.observer.status
         check_jobs_done_once(problem, plans, events)
+        check_nothing_redone(events, story)
         executed = check_executed_timeline(problem, plans, events)
         assert (status.jobs_done, status.jobs_total, status.jobs_running) == \
             (len(jobs), len(jobs), 0), status
@@ -299,6 +301,23 @@ def check_jobs_done_once(problem: Problem, plans, events) -> None:
     problems += [f"job '{j}' done but not in the scenario" for j in sorted(set(done) - jobs)]
     if problems:
         raise AssertionError('; '.join(problems))
+
+
+def check_nothing_redone(events, mission_events) -> None:
+    """No job completed twice, but one the planner voided (a jig job whose hold was lost) and
+    redid; AssertionError naming the jobs otherwise. A completion declared again with the same
+    time (by a planner restarted before it had journaled it) is the same completion."""
+    completions = defaultdict(set)
+    for e in events:
+        if e.kind == TaskEvent.KIND_JOB_DONE:
+            completions[e.mission_id, e.job].add(round(e.time, 6))
+    voided = Counter((e.mission_id, e.job) for e in mission_events
+                     if e.kind == MissionEvent.KIND_JOB_VOIDED)
+    redone = [f"job '{job}' completed {len(times)} times (at t={sorted(times)}), voided "
+              f'{voided[mission, job]} times' for (mission, job), times in sorted(
+                  completions.items()) if len(times) > 1 + voided[mission, job]]
+    if redone:
+        raise AssertionError('work done again: ' + '; '.join(redone))
 
 
 def check_executed_timeline(problem: Problem, plans, events) -> Schedule:

@@ -32,6 +32,7 @@ from fjsp_common.contract import (
     PLAN_TOPIC,
     ROBOT_STATES_TOPIC,
     TASK_EVENTS_TOPIC,
+    agent_node_name,
 )
 from fjsp_common.diagnostics import (
     DIAGNOSTICS_QOS,
@@ -344,10 +345,6 @@ class RobotAgent(Node):
                               values={'type': self.robot_type, 'mission': self.mission_id,
                                       'plan revision': execution.revision,
                                       'failures': self.failures})]))
-
-
-def agent_node_name(robot: str) -> str:
-    return f'agent_{robot}'
 
 
 def robot_name_from_parameters() -> str:
