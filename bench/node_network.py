@@ -31,6 +31,7 @@ from fjsp_common.contract import (
 )
 from fjsp_msgs.msg import MissionStatus, Plan, RobotState, TaskEvent
 from fjsp_planner.fleet import Fleet, Listener
+from fjsp_planner.testing import DomainClaim
 
 LOCALHOST = {'ROS_AUTOMATIC_DISCOVERY_RANGE': 'LOCALHOST'}
 TICKS = os.sysconf('SC_CLK_TCK')
@@ -135,11 +136,18 @@ def run(time_scale, domain, logs):
 def main(argv):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument('--time-scales', type=float, nargs='+', default=[0.02, 0.1])
-    parser.add_argument('--domain', type=int, default=90)
+    parser.add_argument('--domain', type=int, default=None,
+                        help='ROS domain id (default: one no test or bench on this machine '
+                             'holds)')
     args = parser.parse_args(argv)
-    with tempfile.TemporaryDirectory(prefix='fjsp_bench_') as logs:
-        for i, scale in enumerate(args.time_scales):
-            run(scale, args.domain + i, Path(logs))
+    claim = DomainClaim() if args.domain is None else None
+    try:
+        with tempfile.TemporaryDirectory(prefix='fjsp_bench_') as logs:
+            for scale in args.time_scales:
+                run(scale, args.domain if claim is None else claim.domain, Path(logs))
+    finally:
+        if claim is not None:
+            claim.release()
     return 0
 
 

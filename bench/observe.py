@@ -23,7 +23,6 @@ Run from the repository with the workspace sourced:
 
 import argparse
 import os
-import socket
 import statistics
 import sys
 import tempfile
@@ -33,7 +32,12 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / 'test' / 'integration'))
 
-from browser import find_chromium, headless_browser  # noqa: E402
+from browser import (  # noqa: E402
+    find_chromium,
+    free_port,
+    headless_browser,
+    wait_listening,
+)
 
 from fjsp_common.contract import (  # noqa: E402
     MODE_FROM_MSG,
@@ -59,24 +63,6 @@ def memory_mb(pid: int) -> tuple[float, float]:
     status = dict(line.split(':', 1) for line in
                   Path(f'/proc/{pid}/status').read_text().splitlines() if ':' in line)
     return (int(status['VmRSS'].split()[0]) / 1024, int(status['VmHWM'].split()[0]) / 1024)
-
-
-def free_port() -> int:
-    with socket.socket() as probe:
-        probe.bind(('127.0.0.1', 0))
-        return probe.getsockname()[1]
-
-
-def wait_listening(port: int, timeout: float) -> None:
-    deadline = time.monotonic() + timeout
-    while True:
-        try:
-            socket.create_connection(('127.0.0.1', port), timeout=1).close()
-            return
-        except OSError:
-            if time.monotonic() > deadline:
-                raise TimeoutError(f'nothing serves port {port}') from None
-            time.sleep(0.2)
 
 
 def record_robot_states(observer) -> list:
@@ -126,7 +112,8 @@ def run(args, out: Path) -> None:
                                     {'out_dir': out, 'file_name': 'bench.mcap'})
         monitor = fleet.start_monitor(out_dir=out, web_port=port)
         if find_chromium() is not None:
-            wait_listening(port, 30)
+            if not wait_listening(port, 30):
+                raise TimeoutError(f'nothing serves port {port}')
             browser = headless_browser()
             page = browser.__enter__()
             page.get(f'http://127.0.0.1:{port}/')

@@ -28,6 +28,7 @@ from node_network import Recorder, fleet
 from fjsp_common.contract import INJECT_FAULT_SERVICE
 from fjsp_msgs.msg import MissionStatus
 from fjsp_msgs.srv import InjectFault
+from fjsp_planner.testing import DomainClaim
 
 TIME_SCALE = {1: 0.25, 2: 0.1, 5: 0.05}
 """Wall seconds per schedule unit, so that each mission lasts some 8 to 16 s."""
@@ -128,9 +129,14 @@ def main(argv):
     parser.add_argument('--replan-limit', type=float, default=None,
                         help='planner replan_time_limit (default: by panel count)')
     parser.add_argument('--workers', type=int, default=2)
-    parser.add_argument('--domain', type=int, default=91)
+    parser.add_argument('--domain', type=int, default=None,
+                        help='ROS domain id (default: one no test or bench on this machine '
+                             'holds)')
     parser.add_argument('--seed', type=int, default=0)
     args = parser.parse_args(argv)
+    claim = DomainClaim() if args.domain is None else None
+    if claim is not None:
+        args.domain = claim.domain
     rng = random.Random(args.seed)
     summary = []
     with tempfile.TemporaryDirectory() as logs:

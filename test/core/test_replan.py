@@ -141,8 +141,23 @@ def test_holder_that_failed_and_came_back_voids_the_jig_job(small):
 def test_only_a_failure_since_the_jig_job_began_voids_it(small, failed_at, started, voided):
     state = at(small, Fraction(5, 2))
     robots = {**state.robots, 'A': replace(state.robots['A'], last_failure=failed_at)}
-    residual = residual_problem(small, replace(state, robots=robots, started=started), PLAN)
+    done_as = {job: replace(PLAN.jobs[job], start=start) for job, start in started.items()}
+    residual = residual_problem(small, replace(state, robots=robots, done_as=done_as), PLAN)
     assert residual.voided == voided
+
+
+def test_a_hold_is_judged_by_who_did_the_jig_job_not_by_the_latest_plan(small):
+    """W ran on J's hold under a plan that left the done J out; W's holder A then failed and W
+    was aborted. Who held is what J's execution says: J is voided, not an error."""
+    state = at(small, Fraction(4), {'A'})
+    after_j = Schedule({'W': PLAN.jobs['W'], 'F': PLAN.jobs['F']},
+                       {'A': ('W',), 'B': ('W',), 'C': ('F',)})
+    aborted = replace(state, running={name: a for name, a in state.running.items()
+                                      if name != 'W'})
+    residual = residual_problem(small, aborted, after_j)
+    assert residual.voided == ['J']
+    with pytest.raises(ValueError, match='who holds it'):
+        residual_problem(small, replace(aborted, done_as={}), after_j)
 
 
 def test_healthy_holder_keeps_holding(small):
@@ -171,10 +186,11 @@ def test_aborted_held_job_keeps_its_holder(small):
 
 
 def test_holder_known_from_the_running_held_job(small):
-    """A plan made while W ran no longer has J; when W is aborted, W's holder is J's."""
+    """A plan made while W ran no longer has J, and J's execution is not given: when W is
+    aborted, W's holder is J's."""
     later_plan = Schedule({name: a for name, a in PLAN.jobs.items() if name != 'J'},
                           {**PLAN.sequences, 'A': ('W',)})
-    residual = residual_problem(small, at(small, 4, {'B'}), later_plan)
+    residual = residual_problem(small, replace(at(small, 4, {'B'}), done_as={}), later_plan)
     assert residual.kept == ['J']
     # J is known to have ended by W's start at 3, after A's hold of 2.
     assert residual.problem.fixed['J'] == FixedJob(0, Fraction(1), Fraction(4), {'A': 0})
@@ -231,7 +247,7 @@ def test_everything_done_is_complete(small):
 
 def test_kept_jig_job_needs_the_executed_schedule(small):
     with pytest.raises(ValueError, match="job 'J' is done and holds for 'W'"):
-        residual_problem(small, at(small, Fraction(5, 2), {'C'}))
+        residual_problem(small, replace(at(small, Fraction(5, 2), {'C'}), done_as={}))
 
 
 def check_replan(problem, previous, state, **limits):

@@ -6,7 +6,9 @@ background services (updates, sync, QUIC probes) otherwise stall page loads.
 """
 
 import shutil
+import socket
 import tempfile
+import time
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -47,3 +49,23 @@ def headless_browser(width: int = 1400, height: int = 1000):
     finally:
         driver.quit()
         shutil.rmtree(profile, ignore_errors=True)
+
+
+def free_port() -> int:
+    """A TCP port on 127.0.0.1 nothing listens on now (for a monitor's live page)."""
+    with socket.socket() as probe:
+        probe.bind(('127.0.0.1', 0))
+        return probe.getsockname()[1]
+
+
+def wait_listening(port: int, timeout: float) -> bool:
+    """Whether something serves `port` on 127.0.0.1 within `timeout` seconds."""
+    deadline = time.monotonic() + timeout
+    while True:
+        try:
+            socket.create_connection(('127.0.0.1', port), timeout=1).close()
+            return True
+        except OSError:
+            if time.monotonic() > deadline:
+                return False
+            time.sleep(0.2)

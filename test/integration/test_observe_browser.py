@@ -2,12 +2,10 @@
 fleet runs, a robot fails mid-mission, and the page shows what a person watching it must see.
 """
 
-import socket
-import time
 from pathlib import Path
 
 import pytest
-from browser import find_chromium, headless_browser
+from browser import find_chromium, free_port, headless_browser, wait_listening
 
 from fjsp_msgs.msg import MissionStatus
 
@@ -24,25 +22,6 @@ from selenium.webdriver.support.ui import WebDriverWait  # noqa: E402
 
 SLOW = 0.1
 """Wall seconds per schedule unit."""
-
-
-def free_port() -> int:
-    with socket.socket() as probe:
-        probe.bind(('127.0.0.1', 0))
-        return probe.getsockname()[1]
-
-
-def wait_listening(port: int, timeout: float) -> None:
-    deadline = time.monotonic() + timeout
-    while True:
-        try:
-            socket.create_connection(('127.0.0.1', port), timeout=1).close()
-            return
-        except OSError:
-            if time.monotonic() > deadline:
-                pytest.fail(f'the monitor did not serve its page on port {port} within '
-                            f'{timeout:g} s')
-            time.sleep(0.2)
 
 
 # The page redraws its parts as updates come, so it is read in one script call each time
@@ -80,7 +59,7 @@ def test_live_page_follows_a_mission_through_a_failure(fjsp_fleet, tmp_path):
     fleet.start_planner()
     for robot in ROBOTS:
         fleet.start_agent(robot)
-    wait_listening(port, 30)
+    assert wait_listening(port, 30), f'the monitor did not serve its page on port {port}'
     with headless_browser() as page:
         page.get(f'http://127.0.0.1:{port}/')
         wait_page(page, lambda p: text(p, '#state') == 'executing', 60, 'the mission executing')

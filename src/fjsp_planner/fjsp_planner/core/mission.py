@@ -141,6 +141,9 @@ class Note:
     reasons: tuple[str, ...] = ()
     robot: str = ''
     job: str = ''
+    revision: int | None = None
+    """The plan revision it is about, when not the one in force when it is told (a voided
+    job: the revision its completion was reported under)."""
 
 
 Effect = Solve | PublishPlan | JobDone | Note
@@ -646,8 +649,8 @@ class MissionController:
             return [Note(MissionEventKind.WARNING,
                          ('re-plan discarded: ' + ', '.join(f"job '{j}'" for j in progressed)
                           + ' progressed while it was solved',))]
-        notes = [Note(MissionEventKind.JOB_VOIDED, ('its hold was lost',), job=job)
-                 for job in residual.voided]
+        notes = [Note(MissionEventKind.JOB_VOIDED, ('its hold was lost',), job=job,
+                      revision=mission.tracker.revision) for job in residual.voided]
         mission.blocked, mission.blocked_since = (), None
         published = self._publish(mission, residual.problem, result,
                                   continued | frozenset(progressed), solving.reasons)

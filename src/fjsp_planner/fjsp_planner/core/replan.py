@@ -71,9 +71,10 @@ class ExecutionState:
     """Jobs in progress: actual start, plan and robots; `end` is the expected end."""
     robots: Mapping[str, RobotState]
     """Every robot of the problem, by name."""
-    started: Mapping[str, Fraction] = field(default_factory=dict)
-    """Actual starts of completed jobs, where known: a hold is lost if a holder failed after
-    its jig job began (the planned start counts where the actual one is not given)."""
+    done_as: Mapping[str, JobAssignment] = field(default_factory=dict)
+    """How completed jobs were done, where known: their plan, robots and actual times. A
+    done jig job's holders are the robots that did it, and its hold is lost if one of them
+    failed after it began (without it: the previous schedule's robots and planned start)."""
 
 
 @dataclass(frozen=True)
@@ -336,7 +337,9 @@ def _open_holds(problem, state, previous) -> list[_Hold]:
     for source, target, q in problem.holding:
         if source not in state.done or target in state.done:
             continue
-        if previous is not None and source in previous.jobs:
+        if source in state.done_as:
+            robots, began = state.done_as[source].robots, state.done_as[source].start
+        elif previous is not None and source in previous.jobs:
             robots, began = previous.jobs[source].robots, previous.jobs[source].start
         elif target in state.running:
             robots, began = state.running[target].robots, None
@@ -357,10 +360,9 @@ def _open_holds(problem, state, previous) -> list[_Hold]:
 
 def _lost(hold: _Hold, state: ExecutionState) -> bool:
     """A holder failed, however briefly, after the jig job began: what it held was let go."""
-    began = state.started.get(hold.source, hold.began)
     for robot in hold.holders:
         failed = state.robots[robot].last_failure
-        if failed is not None and failed >= began:
+        if failed is not None and failed >= hold.began:
             return True
     return False
 
@@ -564,5 +566,5 @@ def simulated_state(problem: Problem, schedule: Schedule, now: Fraction,
         robots[robot.name] = RobotState(robot.name, robot.name not in failed, location,
                                         max(now, free_at),
                                         now if robot.name in failed else None)
-    started = {name: a.start for name, a in schedule.jobs.items() if name in finished}
-    return ExecutionState(now, frozenset(finished), running, robots, started)
+    done_as = {name: a for name, a in schedule.jobs.items() if name in finished}
+    return ExecutionState(now, frozenset(finished), running, robots, done_as)

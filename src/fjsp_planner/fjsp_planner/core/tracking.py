@@ -438,8 +438,9 @@ class MissionTracker:
                 location, free_at = r.location or None, now_f
             failed_at = None if r.last_failure_at is None else Fraction(r.last_failure_at)
             robots[name] = RobotState(name, r.healthy, location, free_at, failed_at)
-        started = {name: Fraction(self.jobs[name].start) for name in self.done}
-        return ExecutionState(now_f, self.done, running, robots, started)
+        done_as = {name: self.jobs[name].done_as for name in self.done
+                   if self.jobs[name].done_as is not None}
+        return ExecutionState(now_f, self.done, running, robots, done_as)
 
     def violations(self) -> list[str]:
         """Every way the executed timeline (the jobs done so far, as they ran) breaks the

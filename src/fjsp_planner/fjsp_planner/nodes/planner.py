@@ -690,7 +690,8 @@ class PlannerNode(Node):
         self.story_pub.publish(self.auth.sign(MissionEvent(
             stamp=self.get_clock().now().to_msg(),
             event_id=f'planner/{self.incarnation}/{self.event_count}', mission_id=mission.id,
-            kind=MISSION_EVENT_TO_MSG[note.kind], plan_revision=mission.tracker.revision,
+            kind=MISSION_EVENT_TO_MSG[note.kind],
+            plan_revision=mission.tracker.revision if note.revision is None else note.revision,
             time=max(self.controller.now_units(wall), 0.0), robot=note.robot, job=note.job,
             reasons=list(note.reasons)), MISSION_EVENTS_TOPIC))
         self.get_logger().info(shorten(describe(note), 2000))
