@@ -57,13 +57,12 @@ def trial(fleet: FleetHarness, client: MissionClient, panels: int, args) -> floa
     observer.wait_for(lambda o: o.status is not None
                       and o.status.mission_id == mission.mission_id
                       and o.status.jobs_done >= 2, args.timeout, 'the mission under way')
-    revision = observer.status.plan_revision
     began = time.monotonic()
-    client.add_jobs(fragment_yaml=one_more_panel(panels))
+    added = set(client.add_jobs(fragment_yaml=one_more_panel(panels)))
 
     def followed(o) -> bool:
         plans = [p for p in o.plans if p.mission_id == mission.mission_id
-                 and p.revision > revision and any('jobs added' in r for r in p.reasons)]
+                 and added & {t.job for r in p.robots for t in r.tasks}]
         return bool(plans) and all(o.robots[r].plan_revision >= plans[0].revision
                                    for r in ('Assembler', 'LSMS', 'MARC1', 'MARC2'))
 

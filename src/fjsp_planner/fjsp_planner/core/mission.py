@@ -618,8 +618,10 @@ class MissionController:
             return []
         if fleet_now != solving.fleet:
             # The fleet changed while solving: this plan would give work to a robot that is
-            # out, or leave out one that is back. The next tick re-plans from the new state.
+            # out, or leave out one that is back. The next tick re-plans from the new state,
+            # for what this re-plan was for too.
             mission.state = MissionState.EXECUTING
+            mission.pending = solving.reasons
             return [Note(MissionEventKind.WARNING,
                          ('re-plan discarded: the fleet changed while it was solved',))]
         mission.planned = solving.fleet

@@ -9,8 +9,10 @@ story on `mission_events`, its summary on `mission_status` and per-job states on
 
 import hashlib
 import math
+import os
 import secrets
 import sys
+import threading
 import time
 from concurrent.futures import Future, ThreadPoolExecutor
 from datetime import UTC, datetime
@@ -86,6 +88,19 @@ ANSWERS_KEPT = 256
 RUNTIME_PARAMETERS = ('time_limit', 'replan_time_limit', 'workers', 'heartbeat_timeout',
                       'delay_threshold', 'robot_wait_timeout')
 """Honoured when set at run time (read at each use); every other parameter is read-only."""
+
+
+SOLVER_NICENESS = 10
+
+
+def yield_to_the_fleet() -> None:
+    """Lower the priority of a solver thread, and so of the CP-SAT workers it starts: a
+    solve that takes every core must not delay the heartbeats and reports of the robots (a
+    robot whose agent is starved looks offline) or this node's own callbacks."""
+    try:
+        os.setpriority(os.PRIO_PROCESS, threading.get_native_id(), SOLVER_NICENESS)
+    except OSError:
+        pass  # not allowed here: the solve runs at the node's priority
 
 
 def new_mission_id(scenario: str) -> str:
@@ -209,7 +224,8 @@ class PlannerNode(Node):
         self.solves: dict[int, Future] = {}
         # Solves run off the executor so it keeps serving callbacks; two, so that a repair
         # need not wait for the search for a better plan it makes obsolete.
-        self.pool = ThreadPoolExecutor(max_workers=2, thread_name_prefix='solver')
+        self.pool = ThreadPoolExecutor(max_workers=2, thread_name_prefix='solver',
+                                       initializer=yield_to_the_fleet)
         self.solved_guard = self.create_guard_condition(self.collect_solves)
 
         self.plan_pub = self.create_publisher(Plan, PLAN_TOPIC, LATCHED_QOS)
