@@ -399,3 +399,23 @@ def test_first_leg_leaves_from_the_start_location_once_released():
     r = RobotExecution('B')
     plan(r, 1, [task('J1', 0, 1)])
     assert kinds(r.step(0)) == [(ARRIVED, 'J1', 0), (STARTED, 'J1', 0)]
+
+
+def test_a_later_mission_leaves_no_earlier_than_planned_although_placed():
+    """Found by the soak: the truss's D2 (released at 3) ended a mission at bay3; in the next
+    one, placed there, it left for the depot at once, arrived before its release time, and
+    the planner rightly judged the executed timeline invalid (mission FAILED)."""
+    r = RobotExecution('D2')
+    plan(r, 1, [task('J1', 0, 1, location='bay3')])
+    r.step(2)
+    assert r.finished and r.location == 'bay3'
+    r.start_mission()
+    # The next mission's plan has it leave bay3 at its release time, 3, for a 0.3 leg.
+    plan(r, 1, [task('Haul2', 3.3, 1, leg=0.3, location='depot')])
+    assert r.step(1) == []
+    assert r.mode == RobotMode.TRAVELLING and r.busy_until == pytest.approx(3.3)
+    assert kinds(r.step(5)) == [(ARRIVED, 'Haul2', 3.3), (STARTED, 'Haul2', 3.3),
+                                (DONE, 'Haul2', 4.3)]
+    # After its first leg of the mission it leaves as soon as it is free, as always.
+    plan(r, 2, [task('J3', 20, 1, leg=1, location='bay1')], now=5)
+    assert kinds(r.step(6.1)) == [(ARRIVED, 'J3', 6), (STARTED, 'J3', 6)]
