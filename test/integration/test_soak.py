@@ -269,6 +269,24 @@ class Soak:
                 events = [e for e in observer.events if e.mission_id == mission.mission_id]
         mission.problems += check_execution(problem, plans, events,
                                             complete=mission.outcome == 'complete')
+        if mission.problems:
+            self.keep(mission, plans, events)
+
+    def keep(self, mission: Mission, plans, events) -> None:
+        """What the observer saw of a mission that went wrong, next to the node logs."""
+        lines = [f'{mission.line()}\n']
+        for p in plans:
+            lines.append(f'plan revision {p.revision} ({"; ".join(p.reasons)})\n')
+            for r in p.robots:
+                lines.append(f'  {r.robot}: ' + ' -> '.join(
+                    f'{t.job}{"(continued)" if t.continued else ""}@{t.start:g}'
+                    for t in r.tasks) + '\n')
+        for e in events:
+            lines.append(f'{e.event_id} r{e.plan_revision} {e.robot or "planner"} kind {e.kind} '
+                         f'{e.job} t={e.time:.3f}\n')
+        path = self.fleet.out / f'{mission.mission_id}.txt'
+        path.write_text(''.join(lines))
+        mission.problems.append(f'what the observer saw: {path}')
 
 
 def _done(problem, observer, mission_id) -> bool:
@@ -304,6 +322,13 @@ def check_execution(problem, plans, events, complete: bool) -> list[str]:
         holding=tuple((a, b, q) for a, b, q in problem.holding if a in kept and b in kept),
         panels=())
     problems += [f'executed timeline: {p}' for p in validate(part, executed)]
+    # The robots of a job start it at one instant, computed alike from the same reports.
+    starts = {}
+    for e in last:
+        if e.kind == TaskEvent.KIND_STARTED and e.job in kept:
+            starts.setdefault(e.job, {})[e.robot] = e.time
+    problems += [f"job '{j}' started apart: {t}" for j, t in sorted(starts.items())
+                 if max(t.values()) - min(t.values()) > 1e-3]
     return problems
 
 
