@@ -299,12 +299,14 @@ class RobotExecution:
             return self._refuse('fail', 'has already failed')
         events = self.step(now)
         message = f"robot '{self.robot}' failed at t={now:.2f}"
-        if self._phase == _Phase.WORK:
+        if self._phase in (_Phase.WORK, _Phase.WAIT):
+            # At a job not begun yet, its arrival would let its co-workers start without it.
             job = self.task.job
             events.append(Event(EventKind.ABORTED, job, now, self._attempts[job],
                                 f"robot '{self.robot}' failed"))
             self.aborted(job, self.revision)
-            message += f", aborting its operation of job '{job}'"
+            message += (f", aborting its operation of job '{job}'" if self._phase == _Phase.WORK
+                        else f", withdrawing from job '{job}' it was waiting for")
         self._failed_mid_leg = self._phase in (_Phase.TRAVEL, _Phase.TRANSIT)
         if self._failed_mid_leg:
             message += (f" on its way from '{self.location}' to '{self.destination}' "
