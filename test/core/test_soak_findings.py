@@ -153,3 +153,24 @@ def test_a_robot_not_yet_departed_is_replanned_from_its_start_and_release_time()
         tracker.record_robot_state(robot.name, RobotMode.IDLE, '', '', math.nan, at=1.0)
     d2 = tracker.execution_state(1.0).robots['D2']
     assert (d2.location, d2.free_at) == ('depot', 3)
+
+
+@pytest.mark.xfail(strict=True, reason='stale block reasons; fix proposed in '
+                   '/work/patches/net-07-complete-clears-the-block.patch')
+def test_a_mission_completed_while_blocked_no_longer_says_it_is_blocked(planner):
+    """The planner cut off from every robot blocks the mission (nobody to staff anything);
+    the robots, unaware, finish the plan they have, and their reports complete it. Its
+    status said COMPLETE with the reasons of the old block (soak and network tests)."""
+    planner.tick(1.5, heard=())
+    planner.solve_pending()
+    assert planner.mission.state == MissionState.BLOCKED
+    plan, problem = planner.mission.schedule, planner.mission.problem
+    for name, a in sorted(plan.jobs.items(), key=lambda kv: kv[1].start):
+        for robot in a.robots:
+            planner.event(EventKind.STARTED, robot, name, float(a.start))
+        for robot, operation in a.robots.items():
+            end = a.start + problem.duration(robot, operation)
+            planner.event(EventKind.OPERATION_DONE, robot, name, float(end))
+    status = planner.controller.status(planner.wall)
+    assert status.state == MissionState.COMPLETE
+    assert status.blocked == ()

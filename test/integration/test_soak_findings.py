@@ -43,7 +43,9 @@ def started_together(plans, events) -> list[str]:
 
 @pytest.mark.xfail(reason="a restarted agent executes the latched revision its previous "
                    "process was given, and its reports are merged with that process's: a "
-                   "job is 'done' by robots that never worked on it together (see the report)")
+                   "job is 'done' by robots that never worked on it together; fix proposed in "
+                   '/work/patches/net-04-restarted-agent-loses-its-operation.patch with '
+                   'net-06-restarted-agent-waits-for-its-own-plan.patch')
 def test_a_restarted_agent_does_not_finish_alone_a_job_it_began_with_others(fjsp_fleet):
     """On the antenna, S2 is killed while it works on a job with another robot; the planner,
     with S2 offline, cannot staff the dish test (it needs both spiders) and blocks. A new S2
