@@ -163,7 +163,10 @@ def test_fail_while_holding_releases_the_hold():
     r.step(6)
     assert r.mode == RobotMode.HOLDING and r.current_job == 'Aa'
     result = r.fail(6)
-    assert result.accepted and result.events == [] and r.mode == RobotMode.FAILED
+    # It withdraws from Aa, where it held Ja's part waiting for B: B must not start Aa
+    # with it.
+    assert result.accepted and kinds(result.events) == [(ABORTED, 'Aa', 6)]
+    assert r.mode == RobotMode.FAILED
     # The planner voids Ja (its holder failed) and gives A nothing while it is down.
     plan(r, 2, [], {'Ja': {'B'}, 'Aa': {'B'}}, now=6.5)
     r.recover(8)
@@ -399,3 +402,47 @@ def test_first_leg_leaves_from_the_start_location_once_released():
     r = RobotExecution('B')
     plan(r, 1, [task('J1', 0, 1)])
     assert kinds(r.step(0)) == [(ARRIVED, 'J1', 0), (STARTED, 'J1', 0)]
+
+
+def test_a_later_mission_leaves_no_earlier_than_planned_although_placed():
+    """Found by the soak: the truss's D2 (released at 3) ended a mission at bay3; in the next
+    one, placed there, it left for the depot at once, arrived before its release time, and
+    the planner rightly judged the executed timeline invalid (mission FAILED)."""
+    r = RobotExecution('D2')
+    plan(r, 1, [task('J1', 0, 1, location='bay3')])
+    r.step(2)
+    assert r.finished and r.location == 'bay3'
+    r.start_mission()
+    # The next mission's plan has it leave bay3 at its release time, 3, for a 0.3 leg.
+    plan(r, 1, [task('Haul2', 3.3, 1, leg=0.3, location='depot')])
+    assert r.step(1) == []
+    assert r.mode == RobotMode.TRAVELLING and r.busy_until == pytest.approx(3.3)
+    assert kinds(r.step(5)) == [(ARRIVED, 'Haul2', 3.3), (STARTED, 'Haul2', 3.3),
+                                (DONE, 'Haul2', 4.3)]
+    # After its first leg of the mission it leaves as soon as it is free, as always.
+    plan(r, 2, [task('J3', 20, 1, leg=1, location='bay1')], now=5)
+    assert kinds(r.step(6.1)) == [(ARRIVED, 'J3', 6), (STARTED, 'J3', 6)]
+
+
+def test_failing_while_waiting_at_a_job_withdraws_from_it():
+    """Found by the soak: T2 arrived at PetalA, failed there before the job began and
+    recovered at once, its tasks dropped. T1 knew only of its arrival, started PetalA alone,
+    and T2, given the job again, did its part long after: the job ran apart. A robot failing
+    at a job it waits for must say so, as one failing at work does."""
+    a = RobotExecution('A')
+    plan(a, 1, [task('J1', 4, 2, co=['B'], preds=['J0'], arrival=1)],
+         {'J0': {'C'}, 'J1': {'A', 'B'}})
+    a.arrived('B', 'J1', 0.5, 1)
+    assert kinds(a.step(2)) == [(ARRIVED, 'J1', 1)]
+    assert a.mode == RobotMode.WAITING
+    failed = a.fail(3)
+    assert failed.accepted and kinds(failed.events) == [(ABORTED, 'J1', 3)]
+    # B, at J1 too, learns it and does not start J1 with A's arrival when J0 completes.
+    b = RobotExecution('B')
+    plan(b, 1, [task('J1', 4, 2, co=['A'], preds=['J0'], arrival=0.5)],
+         {'J0': {'C'}, 'J1': {'A', 'B'}})
+    b.arrived('A', 'J1', 1, 1)
+    b.step(2)
+    b.aborted('J1', 1)
+    b.job_done('J0', 4, 1)
+    assert b.step(5) == [] and b.mode == RobotMode.WAITING

@@ -180,7 +180,9 @@ class Fleet:
     Every node gets `params_file` (if given), then the launcher's own parameters, which win
     over it: the scenario, and the time scale and output directory unless the file sets them
     and they were not given here. `planner`, `agents` and `monitor` add parameters of those
-    nodes. Logs go to `<out>/logs/<node>.log`.
+    nodes. `prefixes` maps node names to a command the node runs under, e.g.
+    `{'agent_R1': ['ip', 'netns', 'exec', 'rover1']}` to start it in another network
+    namespace, on every (re)start. Logs go to `<out>/logs/<node>.log`.
 
     Start nodes from a thread that lives as long as the fleet (the main thread): the kernel
     sends the parent-death signal when the thread that started a node ends.
@@ -190,7 +192,8 @@ class Fleet:
                  time_scale: float | None = None, params_file=None, out=None,
                  domain: int | None = None, env: dict | None = None,
                  planner: dict | None = None, agents: dict | None = None,
-                 monitor: dict | None = None, key: bool = False):
+                 monitor: dict | None = None, key: bool = False,
+                 prefixes: dict | None = None):
         problems = []
         self.scenario = resolve_scenario(scenario)
         self.problem: Problem | None = None
@@ -240,6 +243,7 @@ class Fleet:
             self.env[KEY_FILE_VARIABLE] = str(self.key_file)
             for params in self.extra.values():
                 params.setdefault('fleet_key_file', self.key_file)
+        self.prefixes = {name: list(prefix) for name, prefix in (prefixes or {}).items()}
         self.processes: dict[str, subprocess.Popen] = {}
         self._streams: list[threading.Thread] = []
 
@@ -291,14 +295,19 @@ class Fleet:
                                {'out_dir': self.out, **params})
 
     def start_node(self, name: str, package: str, executable: str, params=None,
-                   ros_args=(), stream: bool = False) -> subprocess.Popen:
+                   ros_args=(), stream: bool = False, prefix=None) -> subprocess.Popen:
         """Start `executable` of `package` as node `name` with `params` (written to
         `<out>/params/<name>.yaml`, after the user's parameters file) and any further ROS
-        arguments; its log: `<out>/logs/<name>.log` (a node started again appends to it)."""
+        arguments; its log: `<out>/logs/<name>.log` (a node started again appends to it).
+        `prefix` (default: the node's entry of `prefixes`) is a command the node runs under.
+        Stopping reaches the node through its process group whatever the prefix does, but
+        only a prefix that execs the node (as `ip netns exec`, `nice`, `taskset` do) passes
+        on the parent-death signal and the node's own exit code."""
         previous = self.processes.get(name)
         if previous is not None and previous.poll() is None:
             raise FleetError([f"node '{name}' is already running (pid {previous.pid})"])
-        command = [str(find_executable(package, executable)), '--ros-args']
+        prefix = self.prefixes.get(name, ()) if prefix is None else prefix
+        command = [*prefix, str(find_executable(package, executable)), '--ros-args']
         if self.params_file is not None:
             command += ['--params-file', str(self.params_file)]
         if params:

@@ -17,6 +17,10 @@ Each fleet gets a ROS_DOMAIN_ID of its own and keeps discovery on this host
 (ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST), so tests never hear each other; its processes are
 stopped (SIGINT, then SIGKILL) whatever the test does. Every wait is bounded and fails the
 test naming what it waited for.
+
+A fleet can also run across real network links instead (`fjsp_network`, `FleetHarness(...,
+network=...)`): the planner and the monitor on one host, each agent on a host of its own,
+as network namespaces on one bridge whose links a test can cut and restore.
 """
 
 import fcntl
@@ -46,13 +50,26 @@ from fjsp_planner.core.problem import Problem
 from fjsp_planner.core.schedule import JobAssignment, Schedule
 from fjsp_planner.core.validate import validate
 from fjsp_planner.faults import inject_fault
-from fjsp_planner.fleet import Fleet, Listener, find_executable
+from fjsp_planner.fleet import PLANNER_NODE, Fleet, Listener, _environment, find_executable
+from fjsp_planner.hosts import HostsUnavailableError, Network
+from robot_agents.agent_node import agent_node_name
 
 TEST_TIME_SCALE = 0.03
 """Wall seconds per schedule unit: the paper's 32-unit mission takes about a second."""
 TEST_PLANNER = {'time_limit': 5.0, 'start_delay': 0.3}
 """Planner parameters for tests: a first plan within 5 s, a mission start soon after it."""
 DISCOVERY_RANGE = 'LOCALHOST'
+ACROSS_HOSTS = {'ROS_AUTOMATIC_DISCOVERY_RANGE': 'SUBNET', 'FASTDDS_BUILTIN_TRANSPORTS': 'UDPv4'}
+"""DDS settings of a fleet whose nodes run on separate hosts: discovery by multicast on the
+LAN, and UDP only: Fast DDS's shared-memory transport would carry messages between
+namespaces of one machine past a link that is cut."""
+DDS_VARIABLES = ('ROS_AUTOMATIC_DISCOVERY_RANGE', 'ROS_STATIC_PEERS',
+                 'FASTDDS_BUILTIN_TRANSPORTS', 'FASTRTPS_DEFAULT_PROFILES_FILE')
+"""The environment that decides whom a DDS participant discovers and how it talks: the
+observer takes them from the fleet's environment, so it sees what the nodes see."""
+CONTROL_HOST = 'control'
+"""The host of the planner and the monitor in a fleet across hosts; each agent's host is
+named after its robot."""
 
 DOMAINS = range(1, 101)
 """ROS domain ids Fast DDS can use on one host (each maps to its own ports)."""
@@ -86,8 +103,14 @@ class DomainClaim:
 class Observer(Listener):
     """Records every public topic of one domain, from the test process."""
 
-    def __init__(self, domain: int):
-        super().__init__(domain, name='test_observer', discovery_range=DISCOVERY_RANGE)
+    def __init__(self, domain: int, dds: dict | None = None):
+        """`dds`: the DDS_VARIABLES the fleet's nodes have (default: discovery on this
+        host only)."""
+        dds = {'ROS_AUTOMATIC_DISCOVERY_RANGE': DISCOVERY_RANGE, **(dds or {})}
+        # Fast DDS reads its transports when the node's participant is made, after init.
+        with _environment(**dds):
+            super().__init__(domain, name='test_observer',
+                             discovery_range=dds['ROS_AUTOMATIC_DISCOVERY_RANGE'])
         self.plans: list[Plan] = []
         self.events: list[TaskEvent] = []
         self.mission_events: list[MissionEvent] = []
@@ -138,18 +161,50 @@ class Observer(Listener):
 
 class FleetHarness(Fleet):
     """A `Fleet` on a private domain with an `observer` that records its topics from before
-    the first node starts. Defaults suit tests: TEST_TIME_SCALE, TEST_PLANNER, no monitor."""
+    the first node starts. Defaults suit tests: TEST_TIME_SCALE, TEST_PLANNER, no monitor.
+
+    With a `network` (`fjsp_planner.hosts.Network`), each node runs on a host of that LAN:
+    the planner and the monitor on CONTROL_HOST, each agent on a host named after its robot
+    (made when the node first starts), discovering each other by multicast (ACROSS_HOSTS).
+    The observer stays on this machine, which is on the LAN too."""
 
     def __init__(self, scenario=None, *, out, domain: int | None = None,
                  time_scale: float | None = TEST_TIME_SCALE, planner: dict | None = None,
-                 env: dict | None = None, **options):
+                 env: dict | None = None, network: Network | None = None, **options):
         self.claim = DomainClaim() if domain is None else None
         domain = self.claim.domain if domain is None else domain
-        super().__init__(scenario, out=out, domain=domain, time_scale=time_scale,
-                         planner={**TEST_PLANNER, **(planner or {})},
-                         env={'ROS_AUTOMATIC_DISCOVERY_RANGE': DISCOVERY_RANGE, **(env or {})},
-                         **options)
-        self.observer = Observer(domain)
+        self.network = network
+        dds = ACROSS_HOSTS if network is not None else {
+            'ROS_AUTOMATIC_DISCOVERY_RANGE': DISCOVERY_RANGE}
+        try:
+            super().__init__(scenario, out=out, domain=domain, time_scale=time_scale,
+                             planner={**TEST_PLANNER, **(planner or {})},
+                             env={**dds, **(env or {})}, **options)
+            self.observer = Observer(domain, {k: self.env[k] for k in DDS_VARIABLES
+                                              if k in self.env})
+        except BaseException:
+            if self.claim is not None:
+                self.claim.release()
+            raise
+
+    def start_node(self, name: str, *args, **kwargs):
+        if self.network is not None and name not in self.prefixes:
+            self.prefixes[name] = self.network.host(self.host_of(name)).prefix
+        return super().start_node(name, *args, **kwargs)
+
+    @staticmethod
+    def host_of(node: str) -> str:
+        """The host a node runs on in a fleet across hosts."""
+        if node.startswith(agent_node_name('')):
+            return node[len(agent_node_name('')):]
+        return CONTROL_HOST
+
+    def cut(self, node: str = PLANNER_NODE) -> None:
+        """Cut the link of the host `node` runs on (a fleet across hosts only)."""
+        self.network.cut(self.host_of(node))
+
+    def restore(self, node: str = PLANNER_NODE) -> None:
+        self.network.restore(self.host_of(node))
 
     def start(self, *, monitor: bool = False, stream_monitor: bool = False) -> 'FleetHarness':
         super().start(monitor=monitor, stream_monitor=stream_monitor)
@@ -224,6 +279,21 @@ def ros_domain():
         yield claim.domain
     finally:
         claim.release()
+
+
+@pytest.fixture
+def fjsp_network():
+    """A LAN of simulated hosts for this test (`fjsp_planner.hosts.Network`), removed after
+    it; pass it to `fjsp_fleet(..., network=...)`. Skips the test, saying why, where network
+    namespaces cannot be created (not root, no `ip`, no CAP_NET_ADMIN)."""
+    try:
+        network = Network()
+    except HostsUnavailableError as error:
+        pytest.skip(f'cannot test across network links here: {error}')
+    try:
+        yield network
+    finally:
+        network.close()
 
 
 @pytest.fixture

@@ -120,6 +120,8 @@ class RobotExecution:
         self._free_at = 0.0
         self._not_before = 0.0
         """When the latest plan arrived: nothing it orders can begin earlier."""
+        self._departed = False
+        """Whether it has left for its first job of the mission."""
         self._phase_start = math.nan
         self._phase_end = math.nan
         self._holding = ''
@@ -297,12 +299,14 @@ class RobotExecution:
             return self._refuse('fail', 'has already failed')
         events = self.step(now)
         message = f"robot '{self.robot}' failed at t={now:.2f}"
-        if self._phase == _Phase.WORK:
+        if self._phase in (_Phase.WORK, _Phase.WAIT):
+            # At a job not begun yet, its arrival would let its co-workers start without it.
             job = self.task.job
             events.append(Event(EventKind.ABORTED, job, now, self._attempts[job],
                                 f"robot '{self.robot}' failed"))
             self.aborted(job, self.revision)
-            message += f", aborting its operation of job '{job}'"
+            message += (f", aborting its operation of job '{job}'" if self._phase == _Phase.WORK
+                        else f", withdrawing from job '{job}' it was waiting for")
         self._failed_mid_leg = self._phase in (_Phase.TRAVEL, _Phase.TRANSIT)
         if self._failed_mid_leg:
             message += (f" on its way from '{self.location}' to '{self.destination}' "
@@ -469,14 +473,14 @@ class RobotExecution:
         task = self.tasks[self._index]
         self._attempts[task.job] = self._attempts.get(task.job, 0) + 1
         departure = max(self._free_at, self._not_before)
-        if self.location:
-            leg = 0.0 if self._holding else max(task.leg, 0.0)
-        else:
-            # Not placed yet: it leaves from where the plan starts it (the scenario's start
-            # location; a robot that may start anywhere has no first leg), and not before the
-            # plan has it leave (its release time, or the job's start for such a robot).
-            leg = max(task.leg, 0.0)
+        # Not placed yet, it leaves from where the plan starts it (the scenario's start
+        # location; a robot that may start anywhere has no first leg). Placed or not, its
+        # first leg of a mission leaves no earlier than the plan has it leave: its release
+        # time (or the job's start for a robot not placed), which only the plan knows.
+        leg = 0.0 if self._holding else max(task.leg, 0.0)
+        if not self._departed:
             departure = max(departure, task.travel_start)
+            self._departed = True
         self._phase = _Phase.TRAVEL
         self._phase_start = departure
         self._phase_end = later(departure + leg) if leg > 0 else departure
