@@ -16,6 +16,7 @@ from pathlib import Path
 import pytest
 
 from fjsp_common.vocabulary import EventKind, MissionState, RobotMode
+from fjsp_planner.core.journal import PlanRecord
 from fjsp_planner.core.mission import (
     EventReport,
     MissionController,
@@ -100,8 +101,6 @@ def planner():
     return planner
 
 
-@pytest.mark.xfail(strict=True, reason='a failed re-plan blocks the mission until the fleet '
-                   'changes; fix proposed in /work/patches/net-01-retry-failed-replan.patch')
 def test_a_replan_on_a_half_arrived_history_is_retried_once_it_has_arrived(planner):
     plan, problem = planner.mission.schedule, planner.mission.problem
     # Ja holds into Aa: Ja's two robots go straight on to Aa, where a third joins them.
@@ -140,8 +139,6 @@ def test_a_replan_on_a_half_arrived_history_is_retried_once_it_has_arrived(plann
     assert failing not in latest.result.schedule.jobs['Aa'].robots
 
 
-@pytest.mark.xfail(strict=True, reason='the tracker forgets start locations and release times; '
-                   'fix proposed in /work/patches/net-02-replan-keeps-start-and-release.patch')
 def test_a_robot_not_yet_departed_is_replanned_from_its_start_and_release_time():
     """The truss's D2 starts at the depot, released at 3. Its agent reports no location
     until it first moves (it is placed by its first leg), and is idle meanwhile: a re-plan
@@ -155,8 +152,6 @@ def test_a_robot_not_yet_departed_is_replanned_from_its_start_and_release_time()
     assert (d2.location, d2.free_at) == ('depot', 3)
 
 
-@pytest.mark.xfail(strict=True, reason='stale block reasons; fix proposed in '
-                   '/work/patches/net-07-complete-clears-the-block.patch')
 def test_a_mission_completed_while_blocked_no_longer_says_it_is_blocked(planner):
     """The planner cut off from every robot blocks the mission (nobody to staff anything);
     the robots, unaware, finish the plan they have, and their reports complete it. Its
@@ -174,3 +169,34 @@ def test_a_mission_completed_while_blocked_no_longer_says_it_is_blocked(planner)
     status = planner.controller.status(planner.wall)
     assert status.state == MissionState.COMPLETE
     assert status.blocked == ()
+
+
+def test_a_resumed_mission_is_judged_from_where_its_robots_started():
+    """A mission after another one starts each robot where the last left it, and is judged
+    from there. A planner restarted mid-mission rebuilt the mission from its journal with
+    the scenario's start locations instead: the truss's gantry, which began at bay1, was
+    'first at the depot', 16 units of travel from its first job, and the mission FAILED on
+    a violation that never happened (soak: every truss mission whose planner was killed)."""
+    problem = load_scenario(SCENARIOS / 'truss.yaml')
+    here = {r.name: 'bay1' for r in problem.robots}
+    first = MissionController(SETTINGS)
+    wall = 1000.0
+    first.start(problem, 'm2', wall)
+    for name, place in here.items():
+        first.robot_state(RobotReport(name, RobotMode.IDLE, incarnation=1, location=place),
+                          wall)
+    (request,) = [e for e in first.tick(wall + 0.1) if isinstance(e, Solve)]
+    assert {r.start_location for r in request.problem.robots} == {'bay1'}
+    outcome = solve(request.problem, time_limit=5)
+    (published,) = [e for e in first.solved(request.token, outcome, wall + 0.2)
+                    if isinstance(e, PublishPlan)]
+    schedule = published.result.schedule
+    # The planner is killed; a new one resumes the mission from its journal.
+    resumed = MissionController(SETTINGS)
+    resumed.resume('m2', problem, SETTINGS, wall,
+                   [PlanRecord(1, published.mission_start, schedule, frozenset(), (),
+                               published.starts)],
+                   wall + 1)
+    # It judges the mission's execution against the problem it started from.
+    starts = {r.name: r.start_location for r in resumed.mission.problem.robots}
+    assert starts == here

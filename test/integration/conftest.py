@@ -12,4 +12,9 @@ if shutil.which('ros2') is None or 'AMENT_PREFIX_PATH' not in os.environ:
 
 # The harness's fixture, as a user's conftest gets it with pytest_plugins (which pytest
 # allows only in the top-level conftest, and the core tests need no ROS).
-from fjsp_planner.testing import fjsp_fleet, fjsp_network, ros_domain  # noqa: E402, F401
+from fjsp_planner.testing import (  # noqa: E402, F401
+    fjsp_fleet,
+    fjsp_network,
+    pytest_collection_modifyitems,
+    ros_domain,
+)

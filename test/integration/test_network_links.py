@@ -145,10 +145,6 @@ def test_the_planner_cut_off_from_every_robot(lan_fleet):
     no_tracebacks(fleet)
 
 
-@pytest.mark.xfail(reason='a re-plan that fails on a half-arrived history blocks the mission '
-                   'for good (whether the history is half-arrived when it is posed depends on '
-                   'timing; test/core/test_soak_findings.py reproduces it every time); fix '
-                   'proposed in /work/patches/net-01-retry-failed-replan.patch')
 def test_a_robot_failing_while_the_planner_is_cut_off(lan_fleet):
     """While the planner is cut off, MARC1 fails (the operator can still reach it). When the
     link is back, the planner hears the failure at once but the robots' histories of what

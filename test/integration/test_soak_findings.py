@@ -4,18 +4,12 @@ its own that reproduces it on purpose."""
 import time
 from pathlib import Path
 
-import pytest
-
 from fjsp_msgs.msg import MissionStatus, RobotState, TaskEvent
 from fjsp_planner.testing import valid_events
 
 SCENARIOS = Path(__file__).resolve().parents[2] / 'config' / 'scenarios'
 
 
-@pytest.mark.xfail(reason='the planner journals a job done without flushing it before it '
-                   'publishes JOB_DONE, so a planner killed in between declares the job done '
-                   'again once restarted; fix proposed in /work/patches/'
-                   'net-03-journal-done-before-publishing.patch (nodes/planner.py)')
 def test_a_planner_killed_just_after_declaring_a_job_done_does_not_declare_it_again(
         fjsp_fleet, tmp_path):
     fleet = fjsp_fleet(SCENARIOS / 'solar_panel.yaml', time_scale=0.15,
@@ -41,11 +35,6 @@ def started_together(plans, events) -> list[str]:
             if max(times.values()) - min(times.values()) > 1e-3]
 
 
-@pytest.mark.xfail(reason="a restarted agent executes the latched revision its previous "
-                   "process was given, and its reports are merged with that process's: a "
-                   "job is 'done' by robots that never worked on it together; fix proposed in "
-                   '/work/patches/net-04-restarted-agent-loses-its-operation.patch with '
-                   'net-06-restarted-agent-waits-for-its-own-plan.patch')
 def test_a_restarted_agent_does_not_finish_alone_a_job_it_began_with_others(fjsp_fleet):
     """On the antenna, S2 is killed while it works on a job with another robot; the planner,
     with S2 offline, cannot staff the dish test (it needs both spiders) and blocks. A new S2
@@ -70,9 +59,6 @@ def test_a_restarted_agent_does_not_finish_alone_a_job_it_began_with_others(fjsp
     assert not apart, apart
 
 
-@pytest.mark.xfail(reason="a resumed mission is judged from the scenario's start locations, "
-                   'not from where its robots started it; fix proposed in /work/patches/'
-                   'net-05-resume-keeps-where-robots-started.patch')
 def test_a_mission_resumed_after_another_is_judged_from_where_its_robots_started(
         fjsp_fleet, tmp_path):
     """On the truss, the second mission starts each robot where the first left it. Its

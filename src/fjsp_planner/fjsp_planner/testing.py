@@ -281,6 +281,14 @@ def ros_domain():
         claim.release()
 
 
+def pytest_collection_modifyitems(items) -> None:
+    """Tests across network links run first. Fast DDS lists the machine's network
+    interfaces once per process, when its first participant is made: the observer of a test
+    LAN whose bridge came after any other test's participant in this process announces only
+    addresses the LAN's hosts cannot reach, and hears nothing."""
+    items.sort(key=lambda item: 'fjsp_network' not in getattr(item, 'fixturenames', ()))
+
+
 @pytest.fixture
 def fjsp_network():
     """A LAN of simulated hosts for this test (`fjsp_planner.hosts.Network`), removed after

@@ -174,6 +174,12 @@ class RobotAgent(Node):
                       co_workers=tuple(t.co_workers), predecessors=tuple(t.predecessors),
                       held_into_next=t.held_into_next)
                  for t in mine.tasks]
+        if mine.incarnation and mine.incarnation != self.incarnation:
+            # Planned for an earlier process of this robot, whose work in progress died with
+            # it: doing these tasks from scratch would do a job apart from its co-workers.
+            log.warning(f'plan revision {msg.revision} was made for an earlier agent of '
+                        f"robot '{self.robot}': waiting for a revision planned for this one")
+            tasks = []
         now = self.now_units()
         if now >= 0:
             # What was due before the new revision happened under the old one.

@@ -10,7 +10,7 @@ short by a crash is ignored, as is anything after it.
 
 import json
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from fractions import Fraction
 from pathlib import Path
 
@@ -46,6 +46,8 @@ class PlanRecord:
     """None for the revision that cancelled the mission."""
     continued: frozenset[str]
     reasons: tuple[str, ...]
+    starts: dict[str, str | None] = field(default_factory=dict)
+    """Where each robot started the mission (None: anywhere); empty in older journals."""
 
 
 @dataclass(frozen=True)
@@ -148,7 +150,8 @@ def _encode(record: Record) -> dict:
     if isinstance(record, PlanRecord):
         return {'type': 'plan', 'revision': record.revision, 'start': record.start,
                 'schedule': None if record.schedule is None else _schedule(record.schedule),
-                'continued': sorted(record.continued), 'reasons': list(record.reasons)}
+                'continued': sorted(record.continued), 'reasons': list(record.reasons),
+                'starts': dict(record.starts)}
     if isinstance(record, DoneRecord):
         return {'type': 'done', 'job': _assignment(record.assignment),
                 'revision': record.revision}
@@ -168,7 +171,8 @@ def _decode(data: dict) -> Record:
         schedule = data['schedule']
         return PlanRecord(int(data['revision']), float(data['start']),
                           None if schedule is None else _read_schedule(schedule),
-                          frozenset(data['continued']), tuple(data['reasons']))
+                          frozenset(data['continued']), tuple(data['reasons']),
+                          dict(data.get('starts', {})))
     if kind == 'done':
         return DoneRecord(_read_assignment(data['job']), int(data['revision']))
     if kind == 'jobs_added':

@@ -18,6 +18,7 @@ heard again for a full heartbeat timeout, so that one late heartbeat does not re
 
 import math
 from collections import Counter
+from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from fractions import Fraction
 
@@ -36,6 +37,9 @@ hundred ms on 5 panels), published at once; the search for a better one follows.
 CATCH_UP = 0.5
 """Seconds a resumed mission waits, once every robot's event writer is matched, for their
 histories to arrive before it re-plans."""
+
+RETRY_FAILED_REPLAN = 1.0
+"""Seconds after which a re-plan that failed is tried again, if no new report came first."""
 
 STARVED = 0.25
 """Seconds between two ticks beyond which the node could not take messages for a while: the
@@ -122,6 +126,11 @@ class PublishPlan:
     mission_start: float
     """Wall seconds of schedule time 0."""
     cancelled: bool = False
+    incarnations: Mapping[str, int] = field(default_factory=dict)
+    """The agent incarnation each robot's tasks are planned for: the one it reported."""
+    starts: Mapping[str, str | None] = field(default_factory=dict)
+    """Where each robot started the mission (None: anywhere), which need not be where the
+    scenario starts it: journaled, so a resumed mission is judged from the same places."""
 
 
 @dataclass(frozen=True)
@@ -219,9 +228,14 @@ class _Mission:
     """Other missions whose events arrived: each is logged once."""
     warned: set[str] = field(default_factory=set)
     pending: tuple[str, ...] = ()
-    """Reasons of a re-plan still to make (one discarded, jobs added, a restart)."""
+    """Reasons of a re-plan still to make (one discarded or failed, jobs added, a restart)."""
     improving: _Solving | None = None
     """The search for a better plan than the repaired one in force, if any."""
+    reports: int = 0
+    """Task events used so far."""
+    retry: tuple[int, float] | None = None
+    """After a failed re-plan: the reports used and the wall time when it failed; the
+    pending re-plan waits for a new report or RETRY_FAILED_REPLAN seconds."""
     blocked_too_long: bool = False
     resumed: bool = False
     """Rebuilt after a planner restart: re-planned once the fleet has caught it up."""
@@ -295,6 +309,13 @@ class MissionController:
         reported and its event history has arrived (or the robot wait is over)."""
         if self.mission is not None and not self.mission.state.ended:
             raise ValueError(f"mission '{self.mission.id}' is {self.mission.state}")
+        starts = next((r.starts for r in reversed(records)
+                       if isinstance(r, PlanRecord) and r.starts), {})
+        if starts:
+            # The mission began where the robots were, not where the scenario starts them.
+            problem = replace(problem, robots=tuple(
+                replace(r, start_location=starts.get(r.name, r.start_location))
+                for r in problem.robots))
         mission = _Mission(mission_id, problem, settings, MissionTracker(problem), wall,
                            resumed=True)
         tracker = mission.tracker
@@ -337,15 +358,27 @@ class MissionController:
 
     def robot_state(self, report: RobotReport, wall: float) -> list[Effect]:
         agent = self.agents.get(report.robot)
+        restarted = False
         if agent is None:
             agent = self.agents[report.robot] = _Agent(report, wall)
         else:
             if agent.offline_since is not None and agent.back_since is None:
                 agent.back_since = wall
+            restarted = report.incarnation != agent.report.incarnation
             agent.report, agent.heard = report, wall
         mission = self.mission
         if mission is None:
             return []
+        effects: list[Effect] = []
+        if restarted and report.robot in mission.tracker.robots \
+                and mission.tracker.plan is not None:
+            # The operation its previous process was running died with it; the new one
+            # would do it again from scratch, alone, under the revision it finds latched.
+            effects += [Note(MissionEventKind.JOB_ABORTED,
+                             (f"robot '{report.robot}' restarted: its agent lost the "
+                              'operation',), job=job)
+                        for job in mission.tracker.agent_restarted(
+                            report.robot, at=self._now(mission, wall))]
         if report.robot not in mission.tracker.robots:
             outcome = mission.tracker.record_robot_state(report.robot, report.mode, '', '',
                                                          math.nan)
@@ -354,8 +387,8 @@ class MissionController:
             return [Note(MissionEventKind.WARNING, (self._unknown(report.robot),),
                          robot=report.robot)]
         if agent.offline_since is not None:
-            return []  # the tracker hears it again once it counts again
-        return self._record(mission, report, wall)
+            return effects  # the tracker hears it again once it counts again
+        return effects + self._record(mission, report, wall)
 
     def _record(self, mission: _Mission, report: RobotReport, wall: float) -> list[Effect]:
         """Give the tracker a robot's report; the story of what changed."""
@@ -397,6 +430,7 @@ class MissionController:
                                        event.revision, event.time)
         if outcome.ignored:
             return [], f'{outcome.ignored} event: {outcome.reason}'
+        mission.reports += 1
         effects: list[Effect] = []
         if event.kind == EventKind.ABORTED and not aborted_before \
                 and event.job in tracker.aborted:
@@ -436,8 +470,9 @@ class MissionController:
             return effects + self._resume_when_caught_up(mission, wall, publishers)
         if mission.state in (MissionState.EXECUTING, MissionState.BLOCKED):
             reasons = self._replan_reasons(mission, wall)
-            if mission.pending:
+            if mission.pending and (reasons or self._may_retry(mission, wall)):
                 reasons, mission.pending = list(mission.pending) + reasons, ()
+                mission.retry = None
             if reasons and mission.schedule is None:
                 # Blocked before the first plan: plan afresh once the fleet changes.
                 return effects + self._plan(mission, wall)
@@ -450,6 +485,13 @@ class MissionController:
                 effects += self._fail(mission, (f'blocked for {timeout:g} s: '
                                                 + '; '.join(mission.blocked),))
         return effects
+
+    @staticmethod
+    def _may_retry(mission: _Mission, wall: float) -> bool:
+        if mission.retry is None:
+            return True
+        reports, failed_at = mission.retry
+        return mission.reports != reports or wall - failed_at >= RETRY_FAILED_REPLAN
 
     def _check_heartbeats(self, wall: float) -> list[Effect]:
         effects = []
@@ -626,6 +668,12 @@ class MissionController:
                          ('re-plan discarded: the fleet changed while it was solved',))]
         mission.planned = solving.fleet
         if isinstance(outcome, Exception):
+            # The state it was posed from may contradict itself for a while: after a network
+            # partition every robot's state is back at once, but each one's event history
+            # only when its writer resends it, so a job can look started by one robot while
+            # its crew's previous job does not look finished yet. Try again once more is
+            # known, rather than stay blocked until the fleet changes.
+            mission.pending, mission.retry = solving.reasons, (mission.reports, wall)
             return self._block(mission, wall, (f're-planning failed: {outcome}',))
         replanned: Replan = outcome
         residual = replanned.residual
@@ -719,7 +767,10 @@ class MissionController:
         mission.planned_makespan = float(result.makespan)
         mission.replan_reasons = reasons
         mission.state = MissionState.EXECUTING
-        return [PublishPlan(revision, posed, result, continued, reasons, mission.start),
+        starts = {r.name: r.start_location for r in mission.problem.robots}
+        incarnations = {name: planned[0] for name, planned in mission.planned.items()}
+        return [PublishPlan(revision, posed, result, continued, reasons, mission.start,
+                            incarnations=incarnations, starts=starts),
                 Note(MissionEventKind.PLAN_PUBLISHED, reasons)]
 
     def _next_revision(self, mission: _Mission) -> int:
@@ -780,6 +831,8 @@ class MissionController:
         if violations:
             return self._fail(mission, tuple(f'executed timeline: {v}' for v in violations))
         mission.state = MissionState.COMPLETE
+        # A mission blocked for want of robots can still complete on the plan it had.
+        mission.blocked, mission.blocked_since = (), None
         executed = float(mission.tracker.projected_makespan(0))
         return [Note(MissionEventKind.MISSION_COMPLETE,
                      (f'executed makespan {executed:.2f}, planned '

@@ -309,6 +309,24 @@ class MissionTracker:
         self._count_failure(record, was_healthy, at)
         return Outcome()
 
+    def agent_restarted(self, robot: str, at: float | None = None) -> list[str]:
+        """The robot's agent restarted (observed at schedule time `at`): the operations its
+        previous process had not finished are lost, like a failure's. Those jobs are aborted
+        (reports about them wait for a new revision), a hold it kept is lost (a failure is
+        counted), and the aborted jobs are returned. Never raises."""
+        if not isinstance(robot, str) or robot not in self.robots or self.plan is None:
+            return []
+        lost = sorted(name for name in self.running
+                      if robot in self.plan.jobs[name].robots
+                      and robot not in self.jobs[name].operation_done)
+        for name in lost:
+            self.jobs[name] = JobRecord(name, since_revision=self.jobs[name].since_revision,
+                                        aborted=True)
+        record = self.robots[robot]
+        record.failures += 1
+        record.last_failure_at = at if _time_ok(at) else self._latest
+        return lost
+
     def _count_failure(self, record: RobotRecord, was_healthy: bool, at) -> None:
         if was_healthy and not record.healthy:
             record.failures += 1
@@ -428,6 +446,7 @@ class MissionTracker:
                                           ends[name], dict(planned.robots))
         robots = {}
         for name, r in self.robots.items():
+            robot = self.problem.robot(name)
             on = [j for j, a in running.items() if name in a.robots]
             if on:
                 location, free_at = self.problem.job(on[0]).location, running[on[0]].end
@@ -435,7 +454,11 @@ class MissionTracker:
                 arrival = r.busy_until if math.isfinite(r.busy_until) else now
                 location, free_at = r.destination, max(Fraction(arrival), now_f)
             else:
-                location, free_at = r.location or None, now_f
+                # An agent reports no location until its first leg places it: until then
+                # it is where the mission starts it.
+                location, free_at = r.location or robot.start_location, now_f
+            # Nor is it free before its release time, however idle it looks.
+            free_at = max(free_at, Fraction(robot.release_time))
             failed_at = None if r.last_failure_at is None else Fraction(r.last_failure_at)
             robots[name] = RobotState(name, r.healthy, location, free_at, failed_at)
         done_as = {name: self.jobs[name].done_as for name in self.done

@@ -651,7 +651,7 @@ class PlannerNode(Node):
             self.journal.write(PlanRecord(
                 effect.revision, effect.mission_start,
                 None if effect.cancelled else effect.result.schedule, effect.continued,
-                effect.reasons))
+                effect.reasons, dict(effect.starts)))
         stamp = self.get_clock().now().to_msg()
         start = Time(nanoseconds=int(effect.mission_start * 1e9)).to_msg()
         if effect.cancelled:
@@ -660,7 +660,7 @@ class PlannerNode(Node):
         else:
             msg = plan_msg(mission.problem, effect.posed, effect.result.schedule, effect.result,
                            mission.id, effect.revision, start, mission.settings.time_scale,
-                           stamp, effect.continued, effect.reasons)
+                           stamp, effect.continued, effect.reasons, effect.incarnations)
         self.last_published = (msg.mission_id, msg.revision, msg.stamp)
         self.plan_pub.publish(self.auth.sign(msg, PLAN_TOPIC))
         log = self.get_logger()
@@ -685,9 +685,10 @@ class PlannerNode(Node):
     def publish_job_done(self, effect: JobDone) -> None:
         mission = self.controller.mission
         if self.journal is not None:
-            # Flushed by the tick: a done job lost in a crash is rebuilt from the agents'
-            # event histories.
-            self.journal.write(DoneRecord(effect.assignment, effect.revision), sync=False)
+            # On disk before the fleet hears of it: a planner killed after publishing would
+            # otherwise rebuild the job from the agents' event histories once restarted, and
+            # declare it done a second time.
+            self.journal.write(DoneRecord(effect.assignment, effect.revision))
         self.event_count += 1
         event_id = f'planner/{self.incarnation}/{self.event_count}'
         self.job_done_ids.add(event_id)
