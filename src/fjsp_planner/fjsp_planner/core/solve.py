@@ -1,12 +1,13 @@
 """One entry point for every backend, returning the solver-neutral `Result`."""
 
 import dataclasses
+import threading
 import time
 from fractions import Fraction
 
-from fjsp_planner.core import bounds
+from fjsp_planner.core import bounds, tabu
 from fjsp_planner.core.bounds import critical_path_bound
-from fjsp_planner.core.cpsat import solve_cpsat
+from fjsp_planner.core.cpsat import SearchHandle, solve_cpsat
 from fjsp_planner.core.greedy import (
     GreedyOutOfTimeError,
     GreedyStuckError,
@@ -30,6 +31,8 @@ start stitched from their optima (`panels.stitched_schedule`) and the bound of o
 without the robots that cannot move between panels (`bounds.unhelped_panel`)."""
 MIN_PANEL_SECONDS = 0.5
 """Below this the one-panel solves' own overhead outweighs their share."""
+HANDOFF_SHARE = 0.5
+"""Classic FJSP: when CP-SAT restarts from the tabu search's best schedule, if it is behind."""
 
 
 def solve(problem: Problem, solver: str = 'cpsat', time_limit: float = 10.0, workers: int = 2,
@@ -88,6 +91,9 @@ def solve(problem: Problem, solver: str = 'cpsat', time_limit: float = 10.0, wor
         if stitched is not None and stitched.makespan < (hint or greedy).makespan:
             hint, notes = stitched, notes + ('started from panels stitched from one-panel '
                                              'optima',)
+    if solver == 'cpsat' and hint is None and keep is None and greedy is not None and (
+            tabu.applies(problem)):
+        return _classic(problem, greedy, began, time_limit, workers, notes, log)
     setup = time.monotonic() - began
     remaining = max(0.05, time_limit - setup)
     if solver == 'mip':
@@ -112,6 +118,78 @@ def solve(problem: Problem, solver: str = 'cpsat', time_limit: float = 10.0, wor
     if result.schedule is not None and len(problem.panels) >= 2 and not problem.fixed:
         result = _with_panel_bounds(problem, result, panel_bound)
     return result
+
+
+def _classic(problem: Problem, greedy: Schedule, began: float, time_limit: float, workers: int,
+             notes: tuple, log: bool) -> Result:
+    """Single-robot jobs without travel: CP-SAT and the tabu search side by side, from the
+    greedy schedule. CP-SAT proves small instances at once (the search then stops); on larger
+    ones the search usually finds the better schedules, so at HANDOFF_SHARE of the limit a
+    CP-SAT behind it starts again from the search's best, for the bound and the last steps,
+    while the search goes on. The shorter schedule wins; the bound is the best either CP-SAT
+    run proved."""
+    deadline = began + time_limit
+    greedy_seconds = time.monotonic() - began
+    runs = [_Background(problem, deadline, workers, greedy, None, log)]
+    best, best_at = tabu.tabu_search(problem, greedy, began + HANDOFF_SHARE * time_limit,
+                                     stop=runs[0].done)
+    handle, resume = runs[0].handle, best
+    if not runs[0].done() and best.makespan < (handle.best or greedy.makespan) and (
+            not validate(problem, best)):
+        handle.stop()
+        runs.append(_Background(problem, deadline, workers, best, best, log))
+    elif handle.schedule is not None and handle.schedule.makespan < best.makespan and (
+            not validate(problem, handle.schedule)):
+        resume = handle.schedule
+    found, found_at = tabu.tabu_search(problem, resume, deadline, seed=1, stop=runs[-1].done)
+    if found.makespan < best.makespan:
+        best, best_at = found, found_at
+    results = [run.result() for run in runs]
+    if validate(problem, best):
+        best, best_at = greedy, began + greedy_seconds
+    solver = 'greedy' if best is greedy else 'tabu'
+    for run, result in zip(runs, results, strict=True):
+        if result.schedule is not None and result.makespan < best.makespan:
+            best, solver = result.schedule, 'cpsat'
+            best_at = run.started + (result.best_solution_seconds or result.solve_seconds)
+    bound = max((r.lower_bound for r in results if r.lower_bound is not None),
+                default=Fraction(0))
+    bound = min(max(bound, critical_path_bound(problem)), best.makespan)
+    if any(r.status == Status.INFEASIBLE for r in results):
+        raise RuntimeError('CP-SAT found a problem infeasible that has a valid schedule')
+    return Result(Status.OPTIMAL if bound >= best.makespan else Status.FEASIBLE,
+                  best.makespan, bound, time.monotonic() - began, best, solver,
+                  first_solution_seconds=greedy_seconds, best_solution_seconds=best_at - began,
+                  notes=notes + results[-1].notes)
+
+
+class _Background:
+    """`solve_cpsat` in a thread of its own until `deadline`, followed by a `SearchHandle`."""
+
+    def __init__(self, problem, deadline, workers, upper_bound, hint, log):
+        self.handle = SearchHandle()
+        self.started = time.monotonic()
+        self._outcome = {}
+
+        def work():
+            try:
+                self._outcome['result'] = solve_cpsat(
+                    problem, max(0.05, deadline - time.monotonic()), workers,
+                    hint=hint, upper_bound=upper_bound, log=log, handle=self.handle)
+            except BaseException as error:  # re-raised in the caller's thread
+                self._outcome['error'] = error
+
+        self._thread = threading.Thread(target=work, name='cpsat', daemon=True)
+        self._thread.start()
+
+    def done(self) -> bool:
+        return not self._thread.is_alive()
+
+    def result(self) -> Result:
+        self._thread.join()
+        if 'error' in self._outcome:
+            raise self._outcome['error']
+        return self._outcome['result']
 
 
 def _with_panel_bounds(problem: Problem, result: Result, unhelped: Fraction | None) -> Result:

@@ -2,6 +2,6 @@
 `variables`, `constraints` (rules and cuts), `objective`, `model` (assembly, hints, reading a
 solution back) and `search` (running CP-SAT)."""
 
-from fjsp_planner.core.cpsat.search import solve_cpsat
+from fjsp_planner.core.cpsat.search import SearchHandle, solve_cpsat
 
-__all__ = ['solve_cpsat']
+__all__ = ['SearchHandle', 'solve_cpsat']

@@ -1,6 +1,7 @@
 """Running CP-SAT on the model: parameters, time accounting, and the keep-assignments phase."""
 
 import math
+import threading
 import time
 from fractions import Fraction
 
@@ -18,14 +19,40 @@ previous assignments; an unproven makespan gets the whole limit."""
 MIN_SOLVE_SECONDS = 0.01
 
 
+class SearchHandle:
+    """Follows a `solve_cpsat` running in another thread and stops it on request."""
+
+    def __init__(self):
+        self._lock = threading.Lock()
+        self._solver = None
+        self._stopped = False
+        self.best = None
+        """The makespan of the best schedule found so far, in schedule units."""
+        self.schedule = None
+        """The best schedule found so far (read back from every new solution)."""
+
+    def stop(self):
+        with self._lock:
+            self._stopped = True
+            if self._solver is not None:
+                self._solver.stop_search()
+
+    def attach(self, solver) -> bool:
+        """Called once the solver is about to search; False if it was stopped already."""
+        with self._lock:
+            self._solver = solver
+            return not self._stopped
+
+
 def solve_cpsat(problem: Problem, time_limit=10.0, workers=2, hint: Schedule | None = None,
                 keep: Schedule | None = None, upper_bound: Schedule | None = None,
-                log=False) -> Result:
+                log=False, handle: SearchHandle | None = None) -> Result:
     """Minimise the makespan; with `keep`, then prefer `keep`'s (job, robot) assignments.
 
     `upper_bound` is a valid schedule (e.g. greedy) that sets the horizon and, on models with
     routes, is hinted unless `hint` is given. The whole call, model building
     included, ends within `time_limit` seconds (plus CP-SAT's reaction time to its limit).
+    `handle` lets another thread see the best makespan so far and stop the search early.
     """
     began = time.monotonic()
     deadline = began + time_limit
@@ -42,7 +69,9 @@ def solve_cpsat(problem: Problem, time_limit=10.0, workers=2, hint: Schedule | N
                       notes=(f'building the CP-SAT model took the whole {time_limit:g} s',))
     model.minimize_makespan()
     setup = time.monotonic() - began
-    solver, recorder, status = run(model.model, deadline - time.monotonic(), workers, log)
+    solver, recorder, status = run(model.model, deadline - time.monotonic(), workers, log,
+                                   handle=handle,
+                                   scale=model.grid.scale, reader=model.read)
     if status == 'INFEASIBLE':
         return Result(Status.INFEASIBLE, None, None, time.monotonic() - began, None, 'cpsat',
                       notes=model.notes)
@@ -73,11 +102,9 @@ def _since_call(solver_seconds, setup):
     return None if solver_seconds is None else setup + solver_seconds
 
 
-def run(model, time_limit, workers, log, deterministic_limit=None):
+def run(model, time_limit, workers, log, handle=None, scale=1, reader=None):
     solver = cp_model.CpSolver()
     solver.parameters.max_time_in_seconds = max(MIN_SOLVE_SECONDS, time_limit)
-    if deterministic_limit is not None:
-        solver.parameters.max_deterministic_time = deterministic_limit
     solver.parameters.num_workers = workers
     solver.parameters.log_search_progress = log
     # CP-SAT otherwise replaces the process's SIGINT handler, so a node that solved once
@@ -86,23 +113,31 @@ def run(model, time_limit, workers, log, deterministic_limit=None):
     # Presolve probing took the whole budget at 5 panels before any search (and slowed the
     # 1-panel proof 2x), while it did not tighten the bound measurably at 2 panels.
     solver.parameters.cp_model_probing_level = 0
-    recorder = _SolutionTimes()
+    recorder = _SolutionTimes(handle, scale, reader)
+    if handle is not None and not handle.attach(solver):
+        solver.parameters.max_time_in_seconds = MIN_SOLVE_SECONDS
     # status_name() without an argument is broken in ortools 9.15; name the returned status.
     status = solver.solve(model, recorder).name
     return solver, recorder, status
 
 
 class _SolutionTimes(cp_model.CpSolverSolutionCallback):
-    """When the first and the last (best) solutions arrived, in solver wall time."""
+    """When the first and the last (best) solutions arrived, in solver wall time; the best
+    makespan and schedule (read by `reader`) also go to a `SearchHandle`, if any."""
 
-    def __init__(self):
+    def __init__(self, handle=None, scale=1, reader=None):
         super().__init__()
         self.first = self.best = None
+        self.handle, self.scale, self.reader = handle, scale, reader
 
     def on_solution_callback(self):
         if self.first is None:
             self.first = self.wall_time
         self.best = self.wall_time
+        if self.handle is not None:
+            self.handle.best = Fraction(math.ceil(self.objective_value), self.scale)
+            if self.reader is not None:
+                self.handle.schedule = self.reader(self)
 
 
 def _keep_assignments(model: CpsatModel, solver, best, keep, time_limit, workers, log):
