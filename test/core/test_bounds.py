@@ -9,12 +9,14 @@ The MIP (core/mip.py), which has none of CP-SAT's panel cuts, proves the 2-panel
 CP-SAT with the cuts must prove the same value, and every bound must stay at or below it.
 """
 
+import random
 from fractions import Fraction
 from pathlib import Path
 
 import pytest
 
 from fjsp_planner.core import bounds
+from fjsp_planner.core.machine_bound import panel_machine_bound
 from fjsp_planner.core.problem import Job, Problem, Robot
 from fjsp_planner.core.scenario import load_scenario, repeat_panels
 from fjsp_planner.core.schedule import Status
@@ -101,3 +103,70 @@ def test_paper_two_panels_bound_reaches_the_panel_without_the_assembler():
     assert validate(problem, result.schedule) == []
     assert bounds.panel_clique_bound(problem, result.makespan) == 58
     assert 58 <= result.lower_bound <= result.makespan
+
+
+def test_machine_bound_by_hand(two_panels_optimum):
+    """Within 23, S stays in one panel; the arms are G. In the panel without S, y needs both
+    arms (heavy): after x (3, an arm holding), 3 long, then z (1, an arm welding): 7. In the
+    panel with S, y can be S holding (1) and an arm welding: not heavy, only on S's own
+    machine. So the relaxation is 7 <= 11, the MIP's optimum."""
+    assert panel_machine_bound(tiny(2), Fraction(23), 30) == 7 <= two_panels_optimum
+
+
+def test_machine_bound_on_the_paper_two_panels():
+    """docs/solver.md, "Panel machine": the seven heavy jobs of the panel without the
+    Assembler, its four jobs in the other panel and the MARCs' crossings give 84, below the
+    best known 92; the old decomposition bounds gave 58."""
+    problem = load_scenario(PAPER, panels=2)
+    bound = panel_machine_bound(problem, Fraction(92), 60, 2)
+    assert bound == 84
+
+
+def test_solve_reports_the_machine_bound_on_two_panels():
+    problem = load_scenario(PAPER, panels=2)
+    result = solve(problem, time_limit=40)
+    assert validate(problem, result.schedule) == []
+    assert 84 <= result.lower_bound <= result.makespan
+
+
+def random_panel(seed: int) -> Problem:
+    """One panel of three jobs at two places for a slow crosser S (200 per unit of
+    distance) and two arms, plans of one to three operations, a precedence chain with gaps,
+    sometimes a holding arc."""
+    rng = random.Random(seed)
+    types = {'Slow': {0: Fraction(1), 1: Fraction(rng.randint(2, 5)), 2: Fraction(200)},
+             'Arm': {0: Fraction(rng.randint(2, 4)), 1: Fraction(1), 2: Fraction(1)}}
+    robots = (Robot('S', 'Slow'), Robot('A1', 'Arm'),
+              Robot('A2', 'Arm', Fraction(rng.choice([1, 2]))))
+    plans = [((0,),), ((0, 1),), ((0, 0, 1),), ((1,),), ((0, 1), (0, 0))]
+    jobs = tuple(Job(f'j{i}', rng.choice('ab'), rng.choice(plans)) for i in range(3))
+    precedence = tuple((f'j{i}', f'j{i + 1}') for i in range(2) if rng.random() < 0.8)
+    distance = Fraction(rng.randint(1, 3))
+    holding = ()
+    if ('j0', 'j1') in precedence and all(
+            0 in p for p in jobs[0].plans + jobs[1].plans) and rng.random() < 0.6:
+        holding = (('j0', 'j1', 0),)
+    return Problem(operation_types={0: 'hold', 1: 'weld', 2: 'move'}, robot_types=types,
+                   robots=robots, jobs=jobs,
+                   distances={('a', 'b'): distance, ('b', 'a'): distance},
+                   precedence=precedence, holding=holding, locomote=2, name=f'random {seed}')
+
+
+@pytest.mark.parametrize(('seed', 'optimum'), [(2, 409), (8, 10), (9, 22), (13, 11)])
+def test_every_bound_stays_below_mip_proven_optima(seed, optimum):
+    """Random panels repeated twice, 2 apart; the optima are the MIP's, which has no panel
+    cut. With S slow to cross (seeds 8, 9, 13) the decomposition bounds apply; with it fast
+    enough (seed 2) only the machine of the robots that need more than half of the fleet."""
+    problem = repeat_panels(random_panel(seed), 2, 2)
+    mip = solve(problem, solver='mip', mip_backend='SCIP', time_limit=120, workers=1)
+    assert mip.status == Status.OPTIMAL and mip.makespan == optimum
+    exact = solve(problem, time_limit=30)
+    assert exact.status == Status.OPTIMAL and exact.makespan == optimum
+    incumbent = exact.makespan + 1
+    for name, found in [
+            ('machine', panel_machine_bound(problem, incumbent, 30)),
+            ('energy', bounds.panel_energy_bound(problem, incumbent)),
+            ('clique', bounds.panel_clique_bound(problem, incumbent)),
+            ('critical path', bounds.critical_path_bound(problem))]:
+        assert found is None or found <= optimum, name
+    assert panel_machine_bound(problem, incumbent, 30) is not None

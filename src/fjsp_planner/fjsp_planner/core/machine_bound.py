@@ -1,0 +1,292 @@
+"""A lower bound for identical panels from a relaxation CP-SAT solves to optimality: the
+"panel machine" (docs/solver.md, "Bounds").
+
+Let G be the robots that can reach every panel within a known schedule's makespan U (the
+others, "limited", reach only `bounds.panel_limits` many), and call a staffing of a job
+*heavy* when it needs more than half of G. Two heavy staffings together need more of G than
+there is, so heavy jobs run one after another, as on one machine; and a limited robot does
+one job at a time. The relaxation keeps, of every panel:
+
+- the jobs that some staffing makes heavy or gives a limited robot, each with its staffing
+  choices (the robots, the least duration) and whether a choice is heavy;
+- its precedence chains: the least time from a job's end to a later job's start (heads,
+  tails and lags at least durations plus the travel a chain forces: a robot that every
+  staffing of a job needs leaves from that job's place);
+- between jobs of different panels that share a robot under their choices, that robot's
+  crossing from one panel to the other (the slowest of the shared robots, for the cheapest
+  pair of choices);
+
+and forgets the rest (the robots' other jobs, travel inside a panel off the chains). At least
+N - (sum of the limits) panels are done without limited robots; the others may have them all.
+Every schedule shorter than U is a schedule of this relaxation, so its least makespan, or the
+bound CP-SAT proves on it within the time given, bounds every schedule shorter than U, and
+min(bound, U) bounds all. Times are floored onto an integer grid, which only lowers it.
+"""
+
+import itertools
+import math
+from fractions import Fraction
+
+from ortools.sat.python import cp_model
+
+from fjsp_planner.core.bounds import (
+    _staffings,
+    _topological,
+    crossing_cost,
+    panel_limits,
+)
+from fjsp_planner.core.problem import Problem
+
+MAX_CHOICES = 8
+"""Staffing choices kept apart per job and kind of choice; beyond, they merge into one at the
+least duration that stands for all their robot sets (weaker, still a lower bound)."""
+MAX_GRID = 1000
+
+
+class _Choice:
+    """A way to staff a job: its least duration, the robot sets it stands for, whether it
+    needs more than half of G, and the limited robots all its sets have."""
+
+    def __init__(self, duration, sets, heavy, limited):
+        self.duration, self.sets, self.heavy, self.limited = duration, sets, heavy, limited
+
+
+def panel_machine_bound(problem: Problem, incumbent: Fraction, time_limit: float,
+                        workers: int = 1) -> Fraction | None:
+    """The bound of the module docstring, or None when it does not apply (fewer than two
+    panels, running jobs, no robot of G, or nothing heavy) or CP-SAT proves nothing in
+    `time_limit` seconds."""
+    if len(problem.panels) < 2 or problem.fixed:
+        return None
+    limits = panel_limits(problem, incumbent)
+    group = frozenset(r.name for r in problem.robots if r.name not in limits)
+    if not group:
+        return None
+    helped = min(len(problem.panels), sum(limits.values()))
+    kinds = [(len(problem.panels) - helped, sorted(group)),
+             (helped, sorted(r.name for r in problem.robots))]
+    jobs, lags, kind_of = [], {}, []
+    for kind, (count, allowed) in enumerate(kinds):
+        if count == 0:
+            continue
+        shape = _panel_shape(problem, allowed, group, set(limits))
+        if shape is None:
+            return None
+        panel_jobs, panel_lags = _within(shape, incumbent)
+        for _ in range(count):
+            kind_of.append(kind)
+            jobs += [(len(kind_of) - 1, *job) for job in panel_jobs]
+        lags.update({(kind, a, b): lag for (a, b), lag in panel_lags.items()})
+    if not any(c.heavy for *_, choices in jobs for c in choices):
+        return None
+    crossing = {r.name: crossing_cost(problem, r.name) for r in problem.robots}
+    return _solve(jobs, lags, kind_of, crossing, time_limit, workers)
+
+
+def _within(shape, incumbent):
+    """The shape without the choices that make a job end at or after `incumbent` whatever
+    else happens (no schedule shorter than it uses them), a job keeping at least its
+    fastest; jobs left with no heavy choice and no limited robot are dropped."""
+    jobs, lags = shape
+    kept = []
+    for name, head, tail, choices in jobs:
+        fit = [c for c in choices if head + c.duration + tail < incumbent]
+        fit = fit or [min(choices, key=lambda c: c.duration)]
+        if any(c.heavy or c.limited for c in fit):
+            kept.append((name, head, tail, fit))
+    names = {job[0] for job in kept}
+    return kept, {(a, b): lag for (a, b), lag in lags.items() if a in names and b in names}
+
+
+def _panel_shape(problem: Problem, allowed, group, limited):
+    """For one panel staffed from `allowed`: the jobs the relaxation keeps, as (name, head,
+    tail, choices), and the lags between them, or None if some job cannot be staffed."""
+    durations, choices, staffed = {}, {}, {}
+    for name in problem.panels[0]:
+        fastest = {}
+        for plan in problem.job(name).plans:
+            for staffing in _staffings(problem, plan, allowed):
+                robots = frozenset(r for r, _ in staffing)
+                length = max(problem.duration(r, q) for r, q in staffing)
+                fastest[robots] = min(length, fastest.get(robots, length))
+        if not fastest:
+            return None
+        durations[name] = min(fastest.values())
+        staffed[name] = list(fastest)
+        kept = _choices(fastest, group, limited)
+        if any(c.heavy or c.limited for c in kept):
+            choices[name] = kept
+    names = set(problem.panels[0])
+    inside = [(a, b) for a, b in problem.precedence if a in names and b in names]
+    inside += [(a, b) for a, b, _ in problem.holding if a in names and b in names]
+    order = [n for n in _topological(problem) if n in names]
+    successors = {n: [b for a, b in inside if a == n] for n in names}
+    predecessors = {n: [a for a, b in inside if b == n] for n in names}
+    release = min(r.release_time for r in problem.robots if r.name in set(allowed))
+    always = {name: frozenset.intersection(*sets) for name, sets in staffed.items()}
+
+    def moved(a, b):
+        here, there = problem.job(a).location, problem.job(b).location
+        return min(max((problem.travel(r, here, there) for r in robots & always[a]),
+                       default=Fraction(0)) for robots in staffed[b])
+
+    arcs = {(a, b): moved(a, b) for a, b in inside}
+    heads, tails = {}, {}
+    for name in order:
+        heads[name] = max((heads[a] + durations[a] + arcs[a, name]
+                           for a in predecessors[name]), default=release)
+    for name in reversed(order):
+        tails[name] = max((arcs[name, b] + durations[b] + tails[b] for b in successors[name]),
+                          default=Fraction(0))
+    lags = {}
+    for source in choices:
+        # Longest path from the end of `source` to the start of each job after it.
+        reach = {source: Fraction(0)}
+        for name in order[order.index(source):]:
+            if name not in reach:
+                continue
+            for b in successors[name]:
+                gap = reach[name] + (durations[name] if name != source else 0) + arcs[name, b]
+                reach[b] = max(gap, reach.get(b, gap))
+        lags.update({(source, b): reach[b] for b in choices if b != source and b in reach})
+    return [(name, heads[name], tails[name], found) for name, found in choices.items()], lags
+
+
+def _choices(fastest, group, limited) -> list[_Choice]:
+    """Choices from robot set -> least duration: a set that contains another as fast with
+    the same heaviness and limited robots is dropped (its crossings are no cheaper); past
+    MAX_CHOICES of a kind, they merge."""
+    kinds = {}
+    for robots, length in fastest.items():
+        key = (len(robots & group) * 2 > len(group), robots & limited)
+        kinds.setdefault(key, {})[robots] = length
+    out = []
+    for (heavy, mine), sets in sorted(kinds.items(), key=lambda item: sorted(item[1].values())):
+        kept = [(length, robots) for robots, length in sets.items()
+                if not any(other < robots and sets[other] <= length for other in sets)]
+        if len(kept) > MAX_CHOICES:
+            kept = [(min(length for length, _ in kept), tuple(r for _, r in kept))]
+        else:
+            kept = [(length, (robots,)) for length, robots in kept]
+        out += [_Choice(length, sets_, heavy, mine) for length, sets_ in kept]
+    return out
+
+
+def _solve(jobs, lags, kind_of, crossing, time_limit, workers) -> Fraction | None:
+    """CP-SAT on the relaxation: `jobs` (panel, name, head, tail, choices), `lags` (kind,
+    name, later name) -> least time between them inside a panel."""
+    keys = [(panel, name) for panel, name, *_ in jobs]
+    lag = {}
+    for a, b in itertools.permutations(range(len(jobs)), 2):
+        if keys[a][0] == keys[b][0]:
+            found = lags.get((kind_of[keys[a][0]], keys[a][1], keys[b][1]))
+            if found is not None:
+                lag[a, b] = found
+    moves = {}
+    """(a, i, b, j) -> least time between a's end and b's start when a comes first with
+    choice i and b with choice j and the two cannot overlap; absent when they can."""
+    for a, b in itertools.permutations(range(len(jobs)), 2):
+        other_panel = keys[a][0] != keys[b][0]
+        for i, first in enumerate(jobs[a][4]):
+            for j, second in enumerate(jobs[b][4]):
+                # Two heavy staffings always share a robot of G.
+                shared = [x & y for x in first.sets for y in second.sets]
+                if all(shared):
+                    moves[a, i, b, j] = min(max(crossing[r] for r in s) for s in shared) if (
+                        other_panel) else Fraction(0)
+    values = [v for job in jobs for v in (job[2], job[3], *(c.duration for c in job[4]))]
+    values += list(lag.values()) + list(moves.values())
+    scale = min(MAX_GRID, math.lcm(*(v.denominator for v in values)))
+
+    def ticks(value):
+        return value.numerator * scale // value.denominator
+
+    horizon = sum(max(ticks(c.duration) for c in job[4]) + ticks(job[2]) + ticks(job[3])
+                  for job in jobs) + sum(ticks(v) for v in lag.values()) + sum(
+                      ticks(v) for v in moves.values())
+    m = cp_model.CpModel()
+    start, end, picks = [], [], []
+    machine, by_robot = [], {}
+    for panel, name, head, _, choices in jobs:
+        start.append(m.new_int_var(ticks(head), horizon, f'start_{name}_{panel}'))
+        end.append(m.new_int_var(0, horizon, f'end_{name}_{panel}'))
+        picks.append([m.new_bool_var(f'pick_{name}_{panel}_{i}') for i in range(len(choices))])
+        m.add_exactly_one(picks[-1])
+        sizes = [ticks(c.duration) for c in choices]
+        duration = m.new_int_var(min(sizes), max(sizes), f'duration_{name}_{panel}')
+        m.add(duration == sum(p * size for p, size in zip(picks[-1], sizes, strict=True)))
+        heavy = sum(p for p, c in zip(picks[-1], choices, strict=True) if c.heavy)
+        on = m.new_bool_var(f'heavy_{name}_{panel}')
+        m.add(on == heavy)
+        machine.append(m.new_optional_interval_var(start[-1], duration, end[-1], on, ''))
+        for robot in set().union(*(c.limited for c in choices)):
+            uses = m.new_bool_var(f'{robot}_{name}_{panel}')
+            m.add(uses == sum(p for p, c in zip(picks[-1], choices, strict=True)
+                              if robot in c.limited))
+            by_robot.setdefault(robot, []).append(
+                m.new_optional_interval_var(start[-1], duration, end[-1], uses, ''))
+    m.add_no_overlap(machine)
+    for intervals in by_robot.values():
+        m.add_no_overlap(intervals)
+    makespan = m.new_int_var(0, horizon, 'makespan')
+    for k, job in enumerate(jobs):
+        m.add(makespan >= end[k] + ticks(job[3]))
+    for (a, b), found in lag.items():
+        m.add(start[b] >= end[a] + ticks(found))
+    for a, b in itertools.combinations(range(len(jobs)), 2):
+        if (a, b) in lag or (b, a) in lag:
+            continue
+        pairs = [(i, j) for i in range(len(jobs[a][4])) for j in range(len(jobs[b][4]))
+                 if (a, i, b, j) in moves]
+        if not pairs:
+            continue
+        before = m.new_bool_var('')
+        for i, j in pairs:
+            both = (picks[a][i], picks[b][j])
+            m.add(start[b] >= end[a] + ticks(moves[a, i, b, j])).only_enforce_if(before, *both)
+            m.add(start[a] >= end[b] + ticks(moves[b, j, a, i])).only_enforce_if(~before, *both)
+    _path_cut(m, jobs, keys, lag, moves, start, end, makespan, ticks)
+    firsts = {}
+    for k, (panel, *_) in enumerate(jobs):
+        firsts.setdefault(panel, start[k])
+    for panel in sorted(firsts)[1:]:
+        if kind_of[panel] == kind_of[panel - 1]:
+            m.add(firsts[panel - 1] <= firsts[panel])
+    m.minimize(makespan)
+    solver = cp_model.CpSolver()
+    solver.parameters.max_time_in_seconds = max(0.01, time_limit)
+    solver.parameters.num_workers = workers
+    solver.parameters.catch_sigint_signal = False
+    status = solver.solve(m).name
+    if status in ('INFEASIBLE', 'MODEL_INVALID'):
+        return None
+    # Proven whether or not a schedule of the relaxation was found in time.
+    return Fraction(math.ceil(solver.best_objective_bound), scale)
+
+
+def _path_cut(m, jobs, keys, lag, moves, start, end, makespan, ticks):
+    """The jobs every choice makes heavy lie on the machine in some order: the makespan is
+    at least the first one's head, their durations, the least gap between consecutive ones
+    and the last one's tail. Implied, but as one linear sum it reaches the LP relaxation."""
+    always = [k for k, job in enumerate(jobs) if all(c.heavy for c in job[4])]
+    if len(always) < 2:
+        return
+    arcs, gaps = [], []
+    for k in always:
+        first, last = m.new_bool_var(''), m.new_bool_var('')
+        arcs += [(0, k + 1, first), (k + 1, 0, last)]
+        gaps += [first * ticks(jobs[k][2]), last * ticks(jobs[k][3])]
+    for a, b in itertools.permutations(always, 2):
+        if (b, a) in lag:
+            continue
+        if keys[a][0] == keys[b][0]:
+            least = ticks(lag.get((a, b), Fraction(0)))
+        else:
+            least = min(ticks(moves[a, i, b, j]) for i in range(len(jobs[a][4]))
+                        for j in range(len(jobs[b][4])))
+        arc = m.new_bool_var('')
+        arcs.append((a + 1, b + 1, arc))
+        gaps.append(arc * least)
+        m.add(start[b] >= end[a] + least).only_enforce_if(arc)
+    m.add_circuit(arcs)
+    m.add(makespan >= sum(gaps) + sum(end[k] - start[k] for k in always))
