@@ -135,10 +135,25 @@ class Observer(Listener):
 
     def wait_for(self, predicate, timeout: float, what: str = 'a condition') -> None:
         """Wait until `predicate(observer)` holds; fail the test naming `what` after
-        `timeout` seconds."""
-        if not super().wait_for(lambda: predicate(self), timeout):
-            pytest.fail(f'timed out after {timeout:g} s waiting for {what}; last mission '
-                        f'status: {self.status}', pytrace=False)
+        `timeout` seconds.
+
+        A predicate that fails on something not heard yet (an attribute of the status while
+        it is still None, the last of no plans, a robot not seen) counts as not holding: a
+        plan can reach the agents before the first mission status reaches the test. Should
+        the wait time out, the last such error is named."""
+        failed = []
+
+        def holds():
+            try:
+                return predicate(self)
+            except (AttributeError, LookupError) as error:
+                failed[:] = [error]
+                return False
+
+        if not super().wait_for(holds, timeout):
+            raised = f'; the condition last raised {failed[0]!r}' if failed else ''
+            pytest.fail(f'timed out after {timeout:g} s waiting for {what}{raised}; last '
+                        f'mission status: {self.status}', pytrace=False)
 
     def complete(self) -> bool:
         return self.status is not None and self.status.state == MissionStatus.STATE_COMPLETE
