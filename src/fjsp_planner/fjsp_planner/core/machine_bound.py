@@ -65,29 +65,30 @@ def panel_machine_bound(problem: Problem, incumbent: Fraction, time_limit: float
     helped = min(len(problem.panels), sum(limits.values()))
     kinds = [(len(problem.panels) - helped, sorted(group)),
              (helped, sorted(r.name for r in problem.robots))]
-    jobs, lags, kind_of = [], {}, []
+    jobs, lags, holds, kind_of = [], {}, set(), []
     for kind, (count, allowed) in enumerate(kinds):
         if count == 0:
             continue
         shape = _panel_shape(problem, allowed, group, set(limits))
         if shape is None:
             return None
-        panel_jobs, panel_lags = _within(shape, incumbent)
+        panel_jobs, panel_lags, panel_holds = _within(shape, incumbent)
         for _ in range(count):
             kind_of.append(kind)
             jobs += [(len(kind_of) - 1, *job) for job in panel_jobs]
         lags.update({(kind, a, b): lag for (a, b), lag in panel_lags.items()})
+        holds |= {(kind, a, b) for a, b in panel_holds}
     if not any(c.heavy for *_, choices in jobs for c in choices):
         return None
     crossing = {r.name: crossing_cost(problem, r.name) for r in problem.robots}
-    return _solve(jobs, lags, kind_of, crossing, time_limit, workers)
+    return _solve(jobs, lags, holds, kind_of, crossing, time_limit, workers)
 
 
 def _within(shape, incumbent):
     """The shape without the choices that make a job end at or after `incumbent` whatever
     else happens (no schedule shorter than it uses them), a job keeping at least its
     fastest; jobs left with no heavy choice and no limited robot are dropped."""
-    jobs, lags = shape
+    jobs, lags, holds = shape
     kept = []
     for name, head, tail, choices in jobs:
         fit = [c for c in choices if head + c.duration + tail < incumbent]
@@ -95,7 +96,8 @@ def _within(shape, incumbent):
         if any(c.heavy or c.limited for c in fit):
             kept.append((name, head, tail, fit))
     names = {job[0] for job in kept}
-    return kept, {(a, b): lag for (a, b), lag in lags.items() if a in names and b in names}
+    return (kept, {(a, b): lag for (a, b), lag in lags.items() if a in names and b in names},
+            {(a, b) for a, b in holds if a in names and b in names})
 
 
 def _panel_shape(problem: Problem, allowed, group, limited):
@@ -149,7 +151,16 @@ def _panel_shape(problem: Problem, allowed, group, limited):
                 gap = reach[name] + (durations[name] if name != source else 0) + arcs[name, b]
                 reach[b] = max(gap, reach.get(b, gap))
         lags.update({(source, b): reach[b] for b in choices if b != source and b in reach})
-    return [(name, heads[name], tails[name], found) for name, found in choices.items()], lags
+    # Holding arcs whose jig job's every operation is of the held type: all its robots hold
+    # on into the held job, so they are busy from the jig job's start to the held job's end.
+    # Only pairs (a held job that is no jig job, a jig job holding into one job only).
+    sources = [a for a, _, _ in problem.holding]
+    targets = {b for _, b, _ in problem.holding}
+    holds = {(a, b) for a, b, q in problem.holding
+             if a in choices and b in choices and sources.count(a) == 1 and b not in sources
+             and a not in targets and all(set(plan) == {q} for plan in problem.job(a).plans)}
+    jobs = [(name, heads[name], tails[name], found) for name, found in choices.items()]
+    return jobs, lags, holds
 
 
 def _choices(fastest, group, limited) -> list[_Choice]:
@@ -172,9 +183,10 @@ def _choices(fastest, group, limited) -> list[_Choice]:
     return out
 
 
-def _solve(jobs, lags, kind_of, crossing, time_limit, workers) -> Fraction | None:
+def _solve(jobs, lags, holds, kind_of, crossing, time_limit, workers) -> Fraction | None:
     """CP-SAT on the relaxation: `jobs` (panel, name, head, tail, choices), `lags` (kind,
-    name, later name) -> least time between them inside a panel."""
+    name, later name) -> least time between them inside a panel, `holds` (kind, jig job,
+    held job) whose robots are busy from the one's start to the other's end."""
     keys = [(panel, name) for panel, name, *_ in jobs]
     lag = {}
     for a, b in itertools.permutations(range(len(jobs)), 2):
@@ -205,29 +217,24 @@ def _solve(jobs, lags, kind_of, crossing, time_limit, workers) -> Fraction | Non
                   for job in jobs) + sum(ticks(v) for v in lag.values()) + sum(
                       ticks(v) for v in moves.values())
     m = cp_model.CpModel()
-    start, end, picks = [], [], []
-    machine, by_robot = [], {}
+    start, end, length, picks, uses = [], [], [], [], []
+    """uses[k]: resource ('machine' or a limited robot) -> literal: job k takes it."""
     for panel, name, head, _, choices in jobs:
         start.append(m.new_int_var(ticks(head), horizon, f'start_{name}_{panel}'))
         end.append(m.new_int_var(0, horizon, f'end_{name}_{panel}'))
         picks.append([m.new_bool_var(f'pick_{name}_{panel}_{i}') for i in range(len(choices))])
         m.add_exactly_one(picks[-1])
         sizes = [ticks(c.duration) for c in choices]
-        duration = m.new_int_var(min(sizes), max(sizes), f'duration_{name}_{panel}')
-        m.add(duration == sum(p * size for p, size in zip(picks[-1], sizes, strict=True)))
-        heavy = sum(p for p, c in zip(picks[-1], choices, strict=True) if c.heavy)
-        on = m.new_bool_var(f'heavy_{name}_{panel}')
-        m.add(on == heavy)
-        machine.append(m.new_optional_interval_var(start[-1], duration, end[-1], on, ''))
-        for robot in set().union(*(c.limited for c in choices)):
-            uses = m.new_bool_var(f'{robot}_{name}_{panel}')
-            m.add(uses == sum(p for p, c in zip(picks[-1], choices, strict=True)
-                              if robot in c.limited))
-            by_robot.setdefault(robot, []).append(
-                m.new_optional_interval_var(start[-1], duration, end[-1], uses, ''))
-    m.add_no_overlap(machine)
-    for intervals in by_robot.values():
-        m.add_no_overlap(intervals)
+        length.append(m.new_int_var(min(sizes), max(sizes), f'duration_{name}_{panel}'))
+        m.add(length[-1] == sum(p * size for p, size in zip(picks[-1], sizes, strict=True)))
+        m.add(end[-1] == start[-1] + length[-1])
+        taken = {}
+        for resource in ('machine', *set().union(*(c.limited for c in choices))):
+            literal = taken[resource] = m.new_bool_var(f'{resource}_{name}_{panel}')
+            m.add(literal == sum(p for p, c in zip(picks[-1], choices, strict=True)
+                                 if (c.heavy if resource == 'machine' else resource in c.limited)))
+        uses.append(taken)
+    _resources(m, keys, holds, kind_of, start, end, length, uses, horizon)
     makespan = m.new_int_var(0, horizon, 'makespan')
     for k, job in enumerate(jobs):
         m.add(makespan >= end[k] + ticks(job[3]))
@@ -262,6 +269,39 @@ def _solve(jobs, lags, kind_of, crossing, time_limit, workers) -> Fraction | Non
         return None
     # Proven whether or not a schedule of the relaxation was found in time.
     return Fraction(math.ceil(solver.best_objective_bound), scale)
+
+
+def _resources(m, keys, holds, kind_of, start, end, length, uses, horizon):
+    """One no-overlap per resource. A jig job that holds into another takes a resource from
+    its own start to the held job's end when its choice takes it; the held job then takes
+    it on its own only if the jig job's choice does not."""
+    index = {key: k for k, key in enumerate(keys)}
+    held_by = {}
+    for k, (panel, name) in enumerate(keys):
+        for kind, a, b in holds:
+            if kind == kind_of[panel] and a == name:
+                held_by[index[panel, b]] = k
+    spans = {k: b for b, k in held_by.items()}
+    intervals = {}
+    for k, taken in enumerate(uses):
+        for resource, literal in taken.items():
+            if k in spans:
+                b = spans[k]
+                span = m.new_int_var(0, horizon, '')
+                m.add(end[b] == start[k] + span)
+                interval = m.new_optional_interval_var(start[k], span, end[b], literal, '')
+            else:
+                present = literal
+                jig = held_by.get(k)
+                if jig is not None and resource in uses[jig]:
+                    present = m.new_bool_var('')
+                    m.add_bool_and([literal, ~uses[jig][resource]]).only_enforce_if(present)
+                    m.add_bool_or([~literal, uses[jig][resource], present])
+                interval = m.new_optional_interval_var(start[k], length[k], end[k], present,
+                                                       '')
+            intervals.setdefault(resource, []).append(interval)
+    for group in intervals.values():
+        m.add_no_overlap(group)
 
 
 def _path_cut(m, jobs, keys, lag, moves, start, end, makespan, ticks):
