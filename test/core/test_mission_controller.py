@@ -20,7 +20,7 @@ from fjsp_planner.core.mission import (
     Settings,
     Solve,
 )
-from fjsp_planner.core.replan import improve, repair
+from fjsp_planner.core.replan import Improvement, improve, repair
 from fjsp_planner.core.scenario import load_scenario
 from fjsp_planner.core.solve import solve
 
@@ -472,6 +472,40 @@ def test_a_repaired_plan_is_published_at_once_then_bettered(problem):
         assert plan.revision == repaired.revision + 1
         assert plan.result.makespan < repaired.result.makespan
         assert plan.reasons[0].startswith('a better plan: makespan')
+
+
+def test_a_better_plan_is_searched_from_again_until_a_search_finds_no_better(problem):
+    """The searches' outcomes are made up (the repaired plan, said to be better), so that
+    both turns are taken whatever CP-SAT would find."""
+    fleet = executing(problem)
+    fleet.wall += 2
+    fleet.execute(until=2)
+    fleet.failures['MARC1'] += 1
+    fleet.report('MARC1', RobotMode.FAILED)
+    (repair_request,) = kinds(fleet.tick(), Solve)
+    effects = fleet.run_solves([repair_request])
+    (repaired,) = kinds(effects, PublishPlan)
+    (search,) = [e for e in kinds(effects, Solve) if e.kind == 'improve']
+    published = search.published
+    effects = fleet.take(fleet.controller.solved(search.token, Improvement(published, True),
+                                                 fleet.wall))
+    (better,) = kinds(effects, PublishPlan)
+    assert better.revision == repaired.revision + 1
+    (again,) = [e for e in kinds(effects, Solve) if e.kind == 'improve']
+    assert again.published is published and again.token != search.token
+    assert again.time_limit == search.time_limit == SETTINGS.replan_time_limit
+    # Searches that find nothing better double in length, up to 16 re-plan limits.
+    limits = []
+    while True:
+        effects = fleet.take(fleet.controller.solved(again.token,
+                                                     Improvement(published, False), fleet.wall))
+        assert not kinds(effects, PublishPlan)
+        searches = [e for e in kinds(effects, Solve) if e.kind == 'improve']
+        if not searches:
+            break
+        (again,) = searches
+        limits.append(again.time_limit)
+    assert limits == [4.0, 8.0, 16.0, 32.0]
 
 
 def test_a_search_for_a_better_plan_is_dropped_when_the_fleet_changes(problem):
