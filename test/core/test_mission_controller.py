@@ -453,7 +453,8 @@ def test_resume_rebuilds_the_mission_and_replans_above_what_robots_follow(proble
     assert not restarted_jobs & set(mission.tracker.done)
 
 
-def test_a_repaired_plan_is_published_at_once_then_bettered(problem):
+def repaired_after_a_failure(problem):
+    """MARC1 fails at 2: (the fleet, the repaired plan published, the effects of the repair)."""
     fleet = executing(problem)
     fleet.wall += 2
     fleet.execute(until=2)
@@ -462,6 +463,11 @@ def test_a_repaired_plan_is_published_at_once_then_bettered(problem):
     (repair_request,) = kinds(fleet.tick(), Solve)
     effects = fleet.run_solves([repair_request])
     (repaired,) = kinds(effects, PublishPlan)
+    return fleet, repaired, effects
+
+
+def test_a_repaired_plan_is_published_at_once_then_bettered(problem):
+    fleet, repaired, effects = repaired_after_a_failure(problem)
     searches = [e for e in kinds(effects, Solve) if e.kind == 'improve']
     if repaired.result.status == 'optimal':
         assert not searches  # nothing to better
@@ -477,14 +483,7 @@ def test_a_repaired_plan_is_published_at_once_then_bettered(problem):
 def test_a_better_plan_is_searched_from_again_until_a_search_finds_no_better(problem):
     """The searches' outcomes are made up (the repaired plan, said to be better), so that
     both turns are taken whatever CP-SAT would find."""
-    fleet = executing(problem)
-    fleet.wall += 2
-    fleet.execute(until=2)
-    fleet.failures['MARC1'] += 1
-    fleet.report('MARC1', RobotMode.FAILED)
-    (repair_request,) = kinds(fleet.tick(), Solve)
-    effects = fleet.run_solves([repair_request])
-    (repaired,) = kinds(effects, PublishPlan)
+    fleet, repaired, effects = repaired_after_a_failure(problem)
     (search,) = [e for e in kinds(effects, Solve) if e.kind == 'improve']
     published = search.published
     effects = fleet.take(fleet.controller.solved(search.token, Improvement(published, True),
