@@ -32,7 +32,8 @@ def mission(mission_id='m1', accepted=10.0):
 def test_records_round_trip_exactly(tmp_path):
     path = journal_path(tmp_path, 'm1')
     journal = Journal(path)
-    records = [mission(), PlanRecord(1, 12.5, SCHEDULE, frozenset({'Ja'}), ('r',)),
+    records = [mission(), PlanRecord(1, 12.5, SCHEDULE, frozenset({'Ja'}), ('r',),
+                                     {'R1': 'dock', 'R2': None}, {'R1': 7, 'R2': 12}),
                DoneRecord(ASSIGNMENT, 1), JobsAddedRecord('jobs: []', ('A', 'B')),
                PlanRecord(2, 12.5, None, frozenset(), ('cancelled',)),
                EndRecord('cancelled', ('by test',))]

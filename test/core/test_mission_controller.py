@@ -453,6 +453,52 @@ def test_resume_rebuilds_the_mission_and_replans_above_what_robots_follow(proble
     assert not restarted_jobs & set(mission.tracker.done)
 
 
+def test_an_agent_restarted_while_the_planner_was_down_has_its_job_redone(problem):
+    """Found by the soak (truss: R1 killed, the planner killed, R1 started again, then the
+    planner): R2 had begun a job with R1, whose new process knew nothing of it. The resumed
+    planner saw a healthy R1 and let the job go on, and R1 did its part alone 70 units later.
+    The journal names the agent each plan was made for: the job is aborted and redone."""
+    from fjsp_planner.core.journal import DoneRecord, PlanRecord
+
+    fleet = executing(problem)
+    first = kinds(fleet.effects, PublishPlan)[0]
+    assert first.incarnations == dict.fromkeys(ROBOTS, 1)
+    plan = first.result.schedule
+    job = min((a for a in plan.jobs.values() if len(a.robots) >= 2), key=lambda a: a.start)
+    fleet.wall += float(job.start) + 0.1
+    fleet.execute(until=float(job.start) + 0.1)
+    tracker = fleet.controller.mission.tracker
+    assert job.job in tracker.running
+    done = [DoneRecord(tracker.jobs[j].done_as, 1) for j in sorted(tracker.done)]
+    records = [PlanRecord(1, first.mission_start, plan, frozenset(), (),
+                          incarnations=dict(first.incarnations))]
+    # The planner dies; one robot of the job restarts; a new planner resumes.
+    gone, stayed = sorted(job.robots)[:2]
+    restarted = Fleet(problem)
+    restarted.wall = fleet.wall + 1
+    restarted.incarnations[gone] = 2
+    restarted.take(restarted.controller.resume('m1', problem, SETTINGS, fleet.wall,
+                                               records + done, restarted.wall))
+    restarted.following = {'mission_id': 'm1', 'revision': 1}
+    restarted.heartbeat()
+    # The robot that stayed still has its history; the restarted one lost its own.
+    restarted.event(EventKind.STARTED, stayed, job.job, float(job.start), revision=1)
+    requests = []
+    for _ in range(20):
+        requests += kinds(restarted.tick(), Solve)
+        if requests:
+            break
+    (request,) = requests
+    aborted = notes(restarted.effects, MissionEventKind.JOB_ABORTED)
+    assert [n.job for n in aborted] == [job.job]
+    assert f"robot '{gone}' restarted while the planner was down" in aborted[0].reasons[0]
+    assert job.job not in request.state.running
+    (published,) = kinds(restarted.run_solves([request]), PublishPlan)
+    assert job.job in published.result.schedule.jobs
+    assert job.job not in published.continued
+    assert published.incarnations[gone] == 2
+
+
 def repaired_after_a_failure(problem):
     """MARC1 fails at 2: (the fleet, the repaired plan published, the effects of the repair)."""
     fleet = executing(problem)

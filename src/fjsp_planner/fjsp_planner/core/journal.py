@@ -48,6 +48,9 @@ class PlanRecord:
     reasons: tuple[str, ...]
     starts: dict[str, str | None] = field(default_factory=dict)
     """Where each robot started the mission (None: anywhere); empty in older journals."""
+    incarnations: dict[str, int] = field(default_factory=dict)
+    """The agent incarnation each robot's tasks were planned for: a restarted planner tells
+    from it which agents restarted while it was down. Empty in older journals."""
 
 
 @dataclass(frozen=True)
@@ -151,7 +154,7 @@ def _encode(record: Record) -> dict:
         return {'type': 'plan', 'revision': record.revision, 'start': record.start,
                 'schedule': None if record.schedule is None else _schedule(record.schedule),
                 'continued': sorted(record.continued), 'reasons': list(record.reasons),
-                'starts': dict(record.starts)}
+                'starts': dict(record.starts), 'incarnations': dict(record.incarnations)}
     if isinstance(record, DoneRecord):
         return {'type': 'done', 'job': _assignment(record.assignment),
                 'revision': record.revision}
@@ -172,7 +175,8 @@ def _decode(data: dict) -> Record:
         return PlanRecord(int(data['revision']), float(data['start']),
                           None if schedule is None else _read_schedule(schedule),
                           frozenset(data['continued']), tuple(data['reasons']),
-                          dict(data.get('starts', {})))
+                          dict(data.get('starts', {})),
+                          {robot: int(n) for robot, n in data.get('incarnations', {}).items()})
     if kind == 'done':
         return DoneRecord(_read_assignment(data['job']), int(data['revision']))
     if kind == 'jobs_added':

@@ -245,6 +245,9 @@ class _Mission:
     blocked_too_long: bool = False
     resumed: bool = False
     """Rebuilt after a planner restart: re-planned once the fleet has caught it up."""
+    journaled: dict[str, int] = field(default_factory=dict)
+    """Rebuilt after a planner restart: the agent incarnation each robot's tasks were planned
+    for, as the journal has them."""
     caught_up_since: float | None = None
 
 
@@ -331,6 +334,7 @@ class MissionController:
                 mission.schedule, mission.start = record.schedule, record.start
                 mission.planned_makespan = float(record.schedule.makespan)
                 mission.replan_reasons = record.reasons
+                mission.journaled = dict(record.incarnations)
             elif isinstance(record, DoneRecord):
                 tracker.restore_done(record.assignment)
         self.mission = mission
@@ -354,11 +358,31 @@ class MissionController:
         if wall - mission.caught_up_since < CATCH_UP:
             return []
         mission.resumed = False
+        effects = self._restarted_while_down(mission, wall)
         mission.planned = self._fleet(mission, self._unavailable(mission, wall))
         mission.state = MissionState.EXECUTING
         mission.pending = ('planner restarted: what remains is re-planned from where the '
                            'robots are',)
-        return []
+        return effects
+
+    def _restarted_while_down(self, mission: _Mission, wall: float) -> list[Effect]:
+        """Agents that restarted while no planner ran: the operations their previous
+        processes had under way died with them. Their co-workers may have begun those jobs
+        with them, so the jobs are aborted and redone together, as when the planner sees a
+        restart itself. Told once the histories have arrived, so that every job begun is
+        known to have begun."""
+        effects: list[Effect] = []
+        for robot, planned in sorted(mission.journaled.items()):
+            agent = self.agents.get(robot)
+            if not planned or agent is None or agent.report.incarnation == planned:
+                continue
+            effects += [Note(MissionEventKind.JOB_ABORTED,
+                             (f"robot '{robot}' restarted while the planner was down: its "
+                              'agent lost the operation',), job=job)
+                        for job in mission.tracker.agent_restarted(
+                            robot, at=self._now(mission, wall))]
+        mission.journaled = {}
+        return effects
 
     # --- what the fleet reports ----------------------------------------------------------
 

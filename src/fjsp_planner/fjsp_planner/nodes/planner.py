@@ -651,7 +651,7 @@ class PlannerNode(Node):
             self.journal.write(PlanRecord(
                 effect.revision, effect.mission_start,
                 None if effect.cancelled else effect.result.schedule, effect.continued,
-                effect.reasons, dict(effect.starts)))
+                effect.reasons, dict(effect.starts), dict(effect.incarnations)))
         stamp = self.get_clock().now().to_msg()
         start = Time(nanoseconds=int(effect.mission_start * 1e9)).to_msg()
         if effect.cancelled:
