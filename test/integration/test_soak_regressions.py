@@ -85,4 +85,5 @@ def test_a_mission_resumed_after_another_is_judged_from_where_its_robots_started
                        and o.status.state in (MissionStatus.STATE_COMPLETE,
                                               MissionStatus.STATE_FAILED), 90,
                        'the second mission to end')
-    assert observer.status.state == MissionStatus.STATE_COMPLETE, observer.status
+    assert observer.status.state == MissionStatus.STATE_COMPLETE, (
+        observer.status.blocked_reasons, fleet.log('planner')[-4000:])

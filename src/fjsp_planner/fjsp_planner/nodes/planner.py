@@ -227,6 +227,10 @@ class PlannerNode(Node):
         self.pool = ThreadPoolExecutor(max_workers=2, thread_name_prefix='solver',
                                        initializer=yield_to_the_fleet)
         self.solved_guard = self.create_guard_condition(self.collect_solves)
+        self.waking = threading.Lock()
+        self.closing = False
+        """Set under `waking` once the node is being destroyed: a solve ending then has no
+        guard condition left to trigger."""
 
         self.plan_pub = self.create_publisher(Plan, PLAN_TOPIC, LATCHED_QOS)
         self.status_pub = self.create_publisher(MissionStatus, MISSION_STATUS_TOPIC, LATCHED_QOS)
@@ -602,7 +606,13 @@ class PlannerNode(Node):
             future = self.pool.submit(improve, request.published,
                                       time_limit=request.time_limit, workers=workers)
         self.solves[request.token] = future
-        future.add_done_callback(lambda _: self.solved_guard.trigger())
+        future.add_done_callback(self.wake)
+
+    def wake(self, _future) -> None:
+        """Have the executor collect a finished solve (called in the solver's thread)."""
+        with self.waking:
+            if not self.closing:
+                self.solved_guard.trigger()
 
     def collect_solves(self) -> None:
         for token, future in list(self.solves.items()):
@@ -772,6 +782,8 @@ class PlannerNode(Node):
             ignored_unauthenticated=self.auth.rejected), MISSION_STATUS_TOPIC))
 
     def destroy_node(self):
+        with self.waking:
+            self.closing = True
         self.pool.shutdown(wait=False, cancel_futures=True)
         if self.journal is not None:
             self.journal.close()
