@@ -27,7 +27,12 @@ from fjsp_planner.core.scenario import load_scenario
 from fjsp_planner.core.validate import validate
 from fjsp_planner.faults import FaultError
 from fjsp_planner.missions import MissionClient, MissionError
-from fjsp_planner.testing import FleetHarness, executed_timeline, valid_events
+from fjsp_planner.testing import (
+    FleetHarness,
+    executed_timeline,
+    operations_reported,
+    valid_events,
+)
 from robot_agents.agent_node import agent_node_name
 
 SCENARIOS = Path(__file__).resolve().parents[2] / 'config' / 'scenarios'
@@ -265,6 +270,8 @@ class Soak:
             # Each job's last JOB_DONE and every robot's reports come on their own writers.
             observer.wait_for(lambda o: _done(problem, o, mission.mission_id), 15,
                               f'the job-done events of {mission.mission_id}')
+            observer.wait_for(lambda o: _reported(o, mission.mission_id), 15,
+                              f"the robots' reports of {mission.mission_id}")
             with observer.lock:
                 events = [e for e in observer.events if e.mission_id == mission.mission_id]
         mission.problems += check_execution(problem, plans, events,
@@ -294,6 +301,11 @@ def _done(problem, observer, mission_id) -> bool:
     events = [e for e in observer.events if e.mission_id == mission_id]
     done = {e.job for e in valid_events(plans, events) if e.kind == TaskEvent.KIND_JOB_DONE}
     return done >= {j.name for j in problem.jobs}
+
+
+def _reported(observer, mission_id) -> bool:
+    return operations_reported([p for p in observer.plans if p.mission_id == mission_id],
+                               [e for e in observer.events if e.mission_id == mission_id])
 
 
 def check_execution(problem, plans, events, complete: bool) -> list[str]:

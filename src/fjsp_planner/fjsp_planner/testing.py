@@ -251,7 +251,8 @@ class FleetHarness(Fleet):
         self.wait_for(lambda o: o.complete(), timeout, 'the mission to complete')
         # The last job-done events and the status saying complete may come in either order;
         # each agent's event history comes when its writer is discovered.
-        self.wait_for(lambda o: o.jobs_done() >= jobs and _operations_reported(o), 10,
+        self.wait_for(lambda o: o.jobs_done() >= jobs
+                      and operations_reported(o.plans, o.events), 10,
                       "every job-done event and every robot's operation reports")
         with self.observer.lock:
             plans, events = list(self.observer.plans), list(self.observer.events)
@@ -276,12 +277,15 @@ class FleetHarness(Fleet):
         self.close()
 
 
-def _operations_reported(observer: Observer) -> bool:
-    """Every operation the last plan gives a robot reported done in the job's last attempt."""
-    if not observer.plans:
+def operations_reported(plans, events) -> bool:
+    """Every operation the last of `plans` (one mission's) gives a robot reported done in
+    the job's last attempt, among `events`. A robot's reports come on its own writer: an
+    agent restarted late in a mission may be heard after the planner declared its last job
+    done."""
+    if not plans:
         return False
-    planned = {(r.robot, t.job) for r in observer.plans[-1].robots for t in r.tasks}
-    reported = {(e.robot, e.job) for e in valid_events(observer.plans, observer.events)
+    planned = {(r.robot, t.job) for r in plans[-1].robots for t in r.tasks}
+    reported = {(e.robot, e.job) for e in valid_events(plans, events)
                 if e.kind == TaskEvent.KIND_OPERATION_DONE}
     return planned <= reported
 
