@@ -80,7 +80,8 @@ class Soak:
         self.rng = rng
         self.log = log
         self.fleet = FleetHarness(self.path, out=out, time_scale=TIME_SCALE,
-                                  planner={'journal_dir': out / 'journal'})
+                                  planner={'journal_dir': out / 'journal'},
+                                  agents={'reports_dir': out / 'reports'})
         self.robots = [r.name for r in self.fleet.problem.robots]
         self.down: set[str] = set()
         """Nodes killed and not started again yet."""

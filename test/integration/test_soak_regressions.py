@@ -6,6 +6,7 @@ from pathlib import Path
 
 from fjsp_msgs.msg import MissionStatus, RobotState, TaskEvent
 from fjsp_planner.testing import valid_events
+from robot_agents.agent_node import agent_node_name
 
 SCENARIOS = Path(__file__).resolve().parents[2] / 'config' / 'scenarios'
 
@@ -22,6 +23,34 @@ def test_a_planner_killed_just_after_declaring_a_job_done_does_not_declare_it_ag
     fleet.kill('planner')  # within milliseconds of its first JOB_DONE
     fleet.start_planner()
     fleet.check_mission_complete(timeout=90)  # every job declared done exactly once
+
+
+def test_an_agent_killed_while_the_planner_is_down_hands_its_reports_on(fjsp_fleet, tmp_path):
+    """An operation finished while no planner runs is known only to the agent that reported
+    it (and the co-workers and successors that went on from it). Its agent killed too, a
+    planner resuming the mission never learnt it was done, and the mission did not complete.
+    The agent's reports_dir hands the reports to the next agent of the robot."""
+    fleet = fjsp_fleet(SCENARIOS / 'solar_panel.yaml', time_scale=0.15,
+                       planner={'journal_dir': tmp_path / 'journal'},
+                       agents={'reports_dir': tmp_path / 'reports'}).start()
+    observer = fleet.observer
+    fleet.wait_for(lambda o: o.schedule_time() >= 1, 60, 'the mission under way')
+    fleet.kill('planner')
+    with observer.lock:
+        seen = len(observer.events)
+
+    def done_since(o):
+        return [e for e in list(o.events)[seen:] if e.kind == TaskEvent.KIND_OPERATION_DONE]
+
+    fleet.wait_for(done_since, 60, 'an operation done while the planner is down')
+    robot = done_since(observer)[0].robot
+    fleet.kill(agent_node_name(robot))
+    fleet.start_agent(robot)
+    fleet.start_planner()
+    fleet.check_mission_complete(timeout=120)
+    with observer.lock:
+        apart = started_together(list(observer.plans), list(observer.events))
+    assert not apart, apart
 
 
 def started_together(plans, events) -> list[str]:

@@ -13,6 +13,7 @@ through `<robot_name>/inject_fault` (`fjsp_planner.faults`).
 
 import sys
 from collections import deque
+from pathlib import Path
 
 from diagnostic_msgs.msg import DiagnosticArray
 from rclpy.exceptions import InvalidServiceNameException
@@ -45,6 +46,7 @@ from fjsp_common.vocabulary import EventKind, RobotMode
 from fjsp_msgs.msg import Plan, RobotState, TaskEvent
 from fjsp_msgs.srv import InjectFault
 from robot_agents.execution import FaultResult, RobotExecution, Task
+from robot_agents.reports import ReportLog
 
 ANSWERS_KEPT = 1024
 NAME_LOOKUP_NODE = 'robot_agent'
@@ -76,6 +78,10 @@ class RobotAgent(Node):
             self, 'late_threshold', 2.0,
             'schedule units an operation may run past its plan before the robot reports WARN',
             low=0.0, high=1e6)
+        reports_dir = declare(
+            self, 'reports_dir', '',
+            'directory where the agent keeps its reports, so that a planner resuming a '
+            'mission learns what this robot did before its agent restarted; empty: not kept')
         if pinned_type and self.pinned_type != pinned_type:
             raise ParameterError(f"parameter 'robot_type': this executable plays a "
                                  f"'{pinned_type}', got '{self.pinned_type}' (use robot_agent "
@@ -115,6 +121,7 @@ class RobotAgent(Node):
         self.create_timer(tick_period, self.tick)
         self.create_timer(heartbeat_period, self.publish_state)
         self.create_timer(diagnostics_period, self.publish_diagnostics)
+        self.reports = self.open_reports(reports_dir) if reports_dir else None
         self.publish_state()
         kind = f"a '{self.pinned_type}'" if self.pinned_type else 'any type'
         self.get_logger().info(f"robot '{self.robot}' ({kind}) ready, waiting for a plan")
@@ -313,14 +320,58 @@ class RobotAgent(Node):
     def publish_events(self, events) -> None:
         for e in events:
             self.event_count += 1
-            self.event_pub.publish(self.auth.sign(TaskEvent(
+            msg = TaskEvent(
                 stamp=self.get_clock().now().to_msg(),
                 event_id=f'{self.robot}/{self.incarnation}/{self.event_count}',
                 mission_id=self.mission_id, kind=EVENT_TO_MSG[e.kind], robot=self.robot,
                 job=e.job, plan_revision=self.execution.revision, time=e.time,
-                reason=e.reason), TASK_EVENTS_TOPIC))
+                reason=e.reason)
+            if self.reports is not None:
+                self.keep_report(msg)
+            self.event_pub.publish(self.auth.sign(msg, TASK_EVENTS_TOPIC))
             self.get_logger().info(f'{e.kind.value} {e.job} at t={e.time:.2f} (attempt '
                                    f'{e.attempt})' + (f' ({e.reason})' if e.reason else ''))
+
+    def open_reports(self, directory: str) -> ReportLog:
+        """Keep this agent's reports in `directory`, and publish again those an earlier
+        agent of this robot kept there (the latest mission's)."""
+        try:
+            reports = ReportLog(Path(directory).expanduser(), self.robot, EVENT_HISTORY)
+        except OSError as error:
+            raise ParameterError(f"parameter 'reports_dir': cannot keep reports in "
+                                 f'{directory}: {error.strerror or error}') from None
+        published = 0
+        for report in reports.earlier:
+            try:
+                msg = TaskEvent(
+                    stamp=RosTime(seconds=report['sec'],
+                                  nanoseconds=report['nanosec']).to_msg(),
+                    event_id=report['event_id'], mission_id=report['mission_id'],
+                    kind=report['kind'], robot=self.robot, job=report['job'],
+                    plan_revision=report['revision'], time=float(report['time']),
+                    reason=report['reason'])
+            except (AssertionError, ValueError, TypeError, OverflowError):
+                continue  # a damaged line: the others still count
+            self.event_pub.publish(self.auth.sign(msg, TASK_EVENTS_TOPIC))
+            published += 1
+        if published:
+            self.get_logger().info(f'published again {published} reports an earlier agent of '
+                                   f"robot '{self.robot}' kept in {reports.path}")
+        return reports
+
+    def keep_report(self, msg: TaskEvent) -> None:
+        """On disk before anyone hears of it; a disk that refuses it stops the keeping, not
+        the robot."""
+        try:
+            self.reports.append({
+                'sec': msg.stamp.sec, 'nanosec': msg.stamp.nanosec, 'event_id': msg.event_id,
+                'mission_id': msg.mission_id, 'kind': msg.kind, 'robot': msg.robot,
+                'job': msg.job, 'revision': msg.plan_revision, 'time': msg.time,
+                'reason': msg.reason})
+        except OSError as error:
+            self.get_logger().error(f'no longer keeping reports in {self.reports.path}: '
+                                    f'{error.strerror or error}')
+            self.reports = None
 
     def publish_state(self) -> None:
         now = self.now_units()
@@ -351,6 +402,15 @@ class RobotAgent(Node):
                               values={'type': self.robot_type, 'mission': self.mission_id,
                                       'plan revision': execution.revision,
                                       'failures': self.failures})]))
+
+
+    def destroy_node(self):
+        if self.reports is not None:
+            try:
+                self.reports.close()
+            except OSError:
+                pass  # what was written is on its way to disk; nothing more to save
+        return super().destroy_node()
 
 
 def robot_name_from_parameters() -> str:
