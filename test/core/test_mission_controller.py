@@ -453,6 +453,65 @@ def test_resume_rebuilds_the_mission_and_replans_above_what_robots_follow(proble
     assert not restarted_jobs & set(mission.tracker.done)
 
 
+def test_a_resumed_mission_waits_for_each_robots_history_as_far_as_its_state_says(problem):
+    """Under load, the agents' event histories reached a restarted planner later than the
+    half second it used to wait after discovering their writers: it re-planned as if
+    nothing had happened meanwhile, and the robots redid every job since the restart. Each
+    robot's state names the latest event it published; the re-plan waits for it."""
+    from fjsp_planner.core.journal import PlanRecord
+
+    fleet = executing(problem)
+    first = kinds(fleet.effects, PublishPlan)[0]
+    plan = first.result.schedule
+    job = min(plan.jobs.values(), key=lambda a: a.start)
+    records = [PlanRecord(1, first.mission_start, plan, frozenset(), (),
+                          incarnations=dict(first.incarnations))]
+    restarted = Fleet(problem)
+    restarted.wall = fleet.wall + float(job.end) + 1
+    restarted.take(restarted.controller.resume('m1', problem, SETTINGS, fleet.wall, records,
+                                               restarted.wall))
+    # Each robot of the job did its part while no planner ran; its state says so.
+    last = {robot: f'{robot}/done-{job.job}' for robot in job.robots}
+    restarted.following = {'mission_id': 'm1', 'revision': 1}
+
+    def tick():
+        restarted.wall += 0.1
+        for robot in ROBOTS:
+            restarted.report(robot, last_event=last.get(robot, ''))
+        return restarted.take(restarted.controller.tick(restarted.wall))
+
+    for _ in range(10):
+        assert not kinds(tick(), Solve)
+    for robot, q in job.robots.items():
+        for kind, at, name in ((EventKind.STARTED, job.start, f'{robot}/start-{job.job}'),
+                               (EventKind.OPERATION_DONE,
+                                job.start + problem.duration(robot, q), last[robot])):
+            restarted.controller.task_event(EventReport(name, 'm1', kind, robot, job.job, 1,
+                                                        float(at)), restarted.wall)
+    (request,) = kinds(tick() + tick(), Solve)
+    assert job.job in request.state.done
+
+
+def test_a_resumed_mission_waits_for_a_missing_history_no_longer_than_the_robot_wait(problem):
+    from fjsp_planner.core.journal import PlanRecord
+
+    fleet = executing(problem)
+    first = kinds(fleet.effects, PublishPlan)[0]
+    records = [PlanRecord(1, first.mission_start, first.result.schedule, frozenset(), ())]
+    restarted = Fleet(problem)
+    restarted.wall = fleet.wall + 1
+    restarted.take(restarted.controller.resume('m1', problem, SETTINGS, fleet.wall, records,
+                                               restarted.wall))
+    restarted.following = {'mission_id': 'm1', 'revision': 1, 'last_event': 'never/sent'}
+    waited = []
+    for _ in range(60):
+        if kinds(restarted.tick(), Solve):
+            break
+        waited.append(restarted.wall)
+    assert SETTINGS.robot_wait_timeout - 0.2 <= waited[-1] - (fleet.wall + 1) \
+        <= SETTINGS.robot_wait_timeout + 0.1
+
+
 def test_an_agent_restarted_while_the_planner_was_down_has_its_job_redone(problem):
     """Found by the soak (truss: R1 killed, the planner killed, R1 started again, then the
     planner): R2 had begun a job with R1, whose new process knew nothing of it. The resumed

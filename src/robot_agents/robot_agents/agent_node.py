@@ -91,6 +91,8 @@ class RobotAgent(Node):
         self.incarnation = self.auth.signer.incarnation
         """Tells this process's reports from those of an earlier agent of the same robot."""
         self.event_count = 0
+        self.last_event_id = ''
+        """The latest task event published, for the state: a restarted planner waits for it."""
         self.failures = 0
         self.execution = RobotExecution(self.robot)
         self.mission_id = ''
@@ -329,6 +331,7 @@ class RobotAgent(Node):
             if self.reports is not None:
                 self.keep_report(msg)
             self.event_pub.publish(self.auth.sign(msg, TASK_EVENTS_TOPIC))
+            self.last_event_id = msg.event_id
             self.get_logger().info(f'{e.kind.value} {e.job} at t={e.time:.2f} (attempt '
                                    f'{e.attempt})' + (f' ({e.reason})' if e.reason else ''))
 
@@ -353,6 +356,7 @@ class RobotAgent(Node):
             except (AssertionError, ValueError, TypeError, OverflowError):
                 continue  # a damaged line: the others still count
             self.event_pub.publish(self.auth.sign(msg, TASK_EVENTS_TOPIC))
+            self.last_event_id = msg.event_id
             published += 1
         if published:
             self.get_logger().info(f'published again {published} reports an earlier agent of '
@@ -385,7 +389,8 @@ class RobotAgent(Node):
             current_job=execution.current_job, location=execution.location,
             destination=execution.destination,
             progress=execution.progress(now) if now is not None else 0.0,
-            busy_until=execution.busy_until), ROBOT_STATES_TOPIC))
+            busy_until=execution.busy_until, last_event_id=self.last_event_id),
+            ROBOT_STATES_TOPIC))
 
 
     def publish_diagnostics(self) -> None:

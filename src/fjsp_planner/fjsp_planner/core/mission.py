@@ -34,9 +34,10 @@ REPAIR_LIMIT = 0.5
 """Seconds the repair of a plan may take: a valid plan of what remains without search (a few
 hundred ms on 5 panels), published at once; the search for a better one follows."""
 
-CATCH_UP = 0.5
-"""Seconds a resumed mission waits, once every robot's event writer is matched, for their
-histories to arrive before it re-plans."""
+EVENTS_REMEMBERED = 10000
+"""Ids of the latest task events remembered per robot, to tell when the event history a
+robot reports having published has arrived: twice what an agent's writer keeps for late
+joiners."""
 
 LONGEST_SEARCH = 16
 """The longest search for a better plan, in `replan_time_limit`s: searches that find nothing
@@ -81,6 +82,8 @@ class RobotReport:
     destination: str = ''
     busy_until: float = math.nan
     current_job: str = ''
+    last_event: str = ''
+    """The id of the latest task event the agent published ('' if none)."""
 
 
 @dataclass(frozen=True)
@@ -196,6 +199,21 @@ class _Agent:
     """First report after an offline spell: it counts again a heartbeat timeout later."""
 
 
+class _RecentEvents:
+    """Ids of the latest task events received from one robot, oldest first."""
+
+    def __init__(self):
+        self._ids: dict[str, None] = {}
+
+    def add(self, event_id: str) -> None:
+        self._ids[event_id] = None
+        if len(self._ids) > EVENTS_REMEMBERED:
+            del self._ids[next(iter(self._ids))]
+
+    def __contains__(self, event_id: str) -> bool:
+        return event_id in self._ids
+
+
 @dataclass
 class _Solving:
     token: int
@@ -244,17 +262,19 @@ class _Mission:
     pending re-plan waits for a new report or RETRY_FAILED_REPLAN seconds."""
     blocked_too_long: bool = False
     resumed: bool = False
-    """Rebuilt after a planner restart: re-planned once the fleet has caught it up."""
+    """Rebuilt after a planner restart: re-planned once every robot's event history, as far
+    as its latest state says, has arrived."""
     journaled: dict[str, int] = field(default_factory=dict)
     """Rebuilt after a planner restart: the agent incarnation each robot's tasks were planned
     for, as the journal has them."""
-    caught_up_since: float | None = None
 
 
 class MissionController:
     def __init__(self, settings: Settings = Settings()):
         self.settings = settings
         self.agents: dict[str, _Agent] = {}
+        self.events_heard: dict[str, _RecentEvents] = {}
+        """Per robot (of the mission, or heard from), the task events received from it."""
         self.mission: _Mission | None = None
         self._tokens = 0
         self._last_tick: float | None = None
@@ -344,18 +364,18 @@ class MissionController:
         return [Note(MissionEventKind.MISSION_STARTED,
                      (f'resumed after a planner restart {where}',))] + self.tick(wall)
 
-    def _resume_when_caught_up(self, mission, wall, publishers) -> list[Effect]:
+    def _resume_when_caught_up(self, mission, wall) -> list[Effect]:
+        """Re-plan a resumed mission once what the robots did while no planner ran is known:
+        every robot heard has had the latest task event it says it published received (a
+        fixed wait after discovery was too short for a loaded machine, and the re-plan
+        redid what the robots had done meanwhile). A robot whose history does not arrive
+        is waited for at most `robot_wait_timeout`."""
         if mission.schedule is None:
             mission.resumed = False
             return self._plan(mission, wall)
-        heard = sum(self._heard(r.name) for r in mission.problem.robots)
         waited = wall - mission.accepted
-        if publishers is not None and publishers < heard \
-                and waited < mission.settings.robot_wait_timeout:
-            return []
-        if mission.caught_up_since is None:
-            mission.caught_up_since = wall
-        if wall - mission.caught_up_since < CATCH_UP:
+        behind = [r.name for r in mission.problem.robots if not self._caught_up(r.name)]
+        if behind and waited < mission.settings.robot_wait_timeout:
             return []
         mission.resumed = False
         effects = self._restarted_while_down(mission, wall)
@@ -383,6 +403,14 @@ class MissionController:
                             robot, at=self._now(mission, wall))]
         mission.journaled = {}
         return effects
+
+    def _caught_up(self, robot: str) -> bool:
+        """Whether the latest event the robot says it published has been received (events
+        of one writer arrive in order, so all before it have too); true for a robot not
+        heard from."""
+        agent = self.agents.get(robot)
+        last = agent.report.last_event if agent is not None else ''
+        return not last or last in self.events_heard.get(robot, ())
 
     # --- what the fleet reports ----------------------------------------------------------
 
@@ -441,6 +469,9 @@ class MissionController:
     def task_event(self, event: EventReport, wall: float) -> tuple[list[Effect], str]:
         """Use one agent's event; the second item says why it was ignored ('' if used)."""
         mission = self.mission
+        if event.robot in self.agents or (mission is not None
+                                           and event.robot in mission.tracker.robots):
+            self.events_heard.setdefault(event.robot, _RecentEvents()).add(event.event_id)
         if mission is None:
             return [], ''
         tracker = mission.tracker
@@ -475,12 +506,9 @@ class MissionController:
 
     # --- time passing --------------------------------------------------------------------
 
-    def tick(self, wall: float, subscribers: int | None = None,
-             publishers: int | None = None) -> list[Effect]:
+    def tick(self, wall: float, subscribers: int | None = None) -> list[Effect]:
         """Judge heartbeats, start what is due. `subscribers` counts the plan topic's
-        matched readers: the first plan waits until every robot can hear it. `publishers`
-        counts the task-event writers: a resumed mission waits until it has heard every
-        robot's event history."""
+        matched readers: the first plan waits until every robot can hear it."""
         starved = self._last_tick is not None and wall - self._last_tick > STARVED
         self._last_tick = wall
         effects: list[Effect] = []
@@ -497,7 +525,7 @@ class MissionController:
                 return effects
             if not mission.resumed:
                 return effects + self._plan(mission, wall)
-            return effects + self._resume_when_caught_up(mission, wall, publishers)
+            return effects + self._resume_when_caught_up(mission, wall)
         if mission.state in (MissionState.EXECUTING, MissionState.BLOCKED):
             reasons = self._replan_reasons(mission, wall)
             if mission.pending and (reasons or self._may_retry(mission, wall)):

@@ -239,8 +239,7 @@ class PlannerNode(Node):
         self.story_pub = self.create_publisher(MissionEvent, MISSION_EVENTS_TOPIC, EVENTS_QOS)
         self.create_subscription(RobotState, ROBOT_STATES_TOPIC, self.on_robot_state,
                                  ROBOT_STATES_QOS)
-        self.events_sub = self.create_subscription(TaskEvent, TASK_EVENTS_TOPIC, self.on_event,
-                                                   EVENTS_QOS)
+        self.create_subscription(TaskEvent, TASK_EVENTS_TOPIC, self.on_event, EVENTS_QOS)
         self.create_subscription(Plan, PLAN_TOPIC, self.on_plan, LATCHED_QOS)
         self.diagnostics_pub = self.create_publisher(DiagnosticArray, DIAGNOSTICS_TOPIC,
                                                      DIAGNOSTICS_QOS)
@@ -528,8 +527,7 @@ class PlannerNode(Node):
         self.controller.settings = self.settings()
         if self.journal is not None:
             self.journal.sync()
-        self.carry_out(self.controller.tick(self.wall(), self.plan_pub.get_subscription_count(),
-                                            self.events_sub.get_publisher_count()))
+        self.carry_out(self.controller.tick(self.wall(), self.plan_pub.get_subscription_count()))
 
     def on_robot_state(self, msg: RobotState) -> None:
         if not self.auth.accept(msg, ROBOT_STATES_TOPIC, {msg.robot}):
@@ -543,7 +541,8 @@ class PlannerNode(Node):
             robot=msg.robot, mode=mode, incarnation=msg.incarnation, mission_id=msg.mission_id,
             revision=msg.plan_revision, refusal=msg.refusal, failures=msg.failures,
             robot_type=msg.robot_type, location=msg.location, destination=msg.destination,
-            busy_until=msg.busy_until, current_job=msg.current_job)
+            busy_until=msg.busy_until, current_job=msg.current_job,
+            last_event=msg.last_event_id)
         self.carry_out(self.controller.robot_state(report, self.wall()))
 
     def on_event(self, msg: TaskEvent) -> None:
