@@ -198,6 +198,8 @@ class Soak:
             mission.outcome = 'hung'
             mission.problems.append(f'did not end within {deadline - began:.0f} s; last '
                                     f'status {observer.status}')
+            mission.problems.append("the planner's log, its end:\n"
+                                    + self.fleet.log('planner')[-3000:])
             try:
                 self.client.cancel(mission.mission_id, reason='soak: hung')
             except MissionError as error:
@@ -292,9 +294,16 @@ class Soak:
         for e in events:
             lines.append(f'{e.event_id} r{e.plan_revision} {e.robot or "planner"} kind {e.kind} '
                          f'{e.job} t={e.time:.3f}\n')
+        with self.fleet.observer.lock:
+            states = list(self.fleet.observer.robots.values())
+        lines += [f'state {s.robot}: mode {s.mode} job {s.current_job!r} revision '
+                  f'{s.plan_revision} of {s.mission_id} at {s.location!r} -> {s.destination!r}\n'
+                  for s in states]
         path = self.fleet.out / f'{mission.mission_id}.txt'
         path.write_text(''.join(lines))
-        mission.problems.append(f'what the observer saw: {path}')
+        # The CI shows only what the test prints: the end of the record goes with it.
+        mission.problems.append(f'what the observer saw ({path}), its end:\n'
+                                + ''.join(lines)[-4000:])
 
 
 def _done(problem, observer, mission_id) -> bool:
