@@ -4,9 +4,10 @@
 Every robot is busy for the whole of each job it works on, and it must travel between the
 places of its jobs. So whatever the order, a robot's release time, the durations of its jobs
 and the least travel its set of jobs forces fit in the makespan. The least travel is counted
-from which panels and which *places* of a panel the robot visits, a place being a set of job
-locations at distance 0 of each other (the paper's panel has two: the 8 assembly jobs at one
-spot, the 4 moves at another, 35 to 58 apart):
+from which panels and which *places* of a panel the robot visits, a place being the job
+locations of a panel joined by distances 0 (the paper's panel has two: the 8 assembly jobs at one
+spot, the 4 moves at another, 35 to 58 apart; a robot goes straight from one job to the next,
+so moving between two places of a panel costs at least the least distance between two):
 
 - a robot that visits p panels and c places in all enters panels E >= p times, so it makes at
   least E - 1 moves between panels, each at least the least distance between two panels (x,
@@ -30,10 +31,18 @@ from fractions import Fraction
 
 from ortools.sat.python import cp_model
 
-from fjsp_planner.core.bounds import _heads_and_tails, _staffings, panel_limits
+from fjsp_planner.core.bounds import (
+    _heads_and_tails,
+    _panel_distance,
+    _staffings,
+    panel_limits,
+)
 from fjsp_planner.core.problem import Problem
 
 MAX_GRID = 1000
+MAX_CHOICES = 20_000
+"""Staffing literals beyond which building the model alone would take seconds (the paper's
+10 panels have 580); large fleets and many panels go without this bound."""
 
 
 def panel_load_bound(problem: Problem, incumbent: Fraction, time_limit: float,
@@ -45,8 +54,10 @@ def panel_load_bound(problem: Problem, incumbent: Fraction, time_limit: float,
     if len(panels) < 2 or problem.fixed or sum(map(len, panels)) != len(problem.jobs):
         return None
     choices = _choices(problem, incumbent)
+    if sum(len(found) for found in choices.values()) > MAX_CHOICES:
+        return None
     places, between_places = _places(problem)
-    between_panels = _between_panels(problem)
+    between_panels = _panel_distance(problem)
     factors = {r.name: _travel_factor(problem, r.name) for r in problem.robots}
     values = [d for found in choices.values() for d, _ in found]
     values += [r.release_time for r in problem.robots]
@@ -138,19 +149,27 @@ def _choices(problem: Problem, incumbent: Fraction):
     `incumbent` whatever else happens (the fastest is kept regardless)."""
     heads, tails = _heads_and_tails(problem)
     robots = sorted(r.name for r in problem.robots)
-    out = {}
+    out, known = {}, {}
     for job in problem.jobs:
-        fastest = {}
-        for plan in job.plans:
-            for staffing in _staffings(problem, plan, robots):
-                key = frozenset(r for r, _ in staffing)
-                length = max(problem.duration(r, q) for r, q in staffing)
-                fastest[key] = min(length, fastest.get(key, length))
-        found = sorted((d, tuple(sorted(s))) for s, d in fastest.items()
-                       if not any(o < s and fastest[o] <= d for o in fastest))
-        fit = [(d, s) for d, s in found if heads[job.name] + d + tails[job.name] < incumbent]
-        out[job.name] = fit or found[:1]
+        # Copies of a job in other panels have the same plans, heads and tails.
+        key = (job.plans, heads[job.name], tails[job.name])
+        if key not in known:
+            known[key] = _fitting(problem, job.plans, robots, heads[job.name] + tails[job.name],
+                                  incumbent)
+        out[job.name] = known[key]
     return out
+
+
+def _fitting(problem, plans, robots, around, incumbent):
+    fastest = {}
+    for plan in plans:
+        for staffing in _staffings(problem, plan, robots):
+            key = frozenset(r for r, _ in staffing)
+            length = max(problem.duration(r, q) for r, q in staffing)
+            fastest[key] = min(length, fastest.get(key, length))
+    found = sorted((d, tuple(sorted(s))) for s, d in fastest.items()
+                   if not any(o < s and fastest[o] <= d for o in fastest))
+    return [(d, s) for d, s in found if around + d < incumbent] or found[:1]
 
 
 def _travel_factor(problem: Problem, robot: str) -> Fraction:
@@ -160,37 +179,29 @@ def _travel_factor(problem: Problem, robot: str) -> Fraction:
     return problem.robot_types[r.type][problem.locomote] / r.speed
 
 
-def _between_panels(problem: Problem) -> Fraction:
-    """Least distance from a job location of one panel to one of another."""
-    places = [{problem.job(n).location for n in names} for names in problem.panels]
-    return min(problem.distance(a, b) for k, first in enumerate(places)
-               for second in places[k + 1:] for a in first for b in second)
-
-
 def _places(problem: Problem):
-    """(job -> its place: the panel and the first of the job locations at distance 0 of its
-    own, on shortest paths over the panel's locations; the least distance between two places
-    of a panel, 0 if no panel has two)."""
+    """(job -> its place: the panel and one of the job locations joined to its own by
+    distances 0; the least distance between two places of a panel, 0 if no panel has two).
+    A robot goes straight from one job to the next, so a move between places costs at least
+    that least distance."""
     place, least = {}, None
     for k, names in enumerate(problem.panels):
         spots = sorted({problem.job(n).location for n in names})
-        paths = _shortest_paths(problem, spots)
-        # Shortest paths are a metric: distance 0 is an equivalence.
-        first = {a: next(b for b in spots if paths[a][b] == 0) for a in spots}
+        root = {a: a for a in spots}
+        for i, a in enumerate(spots):
+            for b in spots[i + 1:]:
+                if problem.distance(a, b) == 0 or problem.distance(b, a) == 0:
+                    root[_find(root, b)] = _find(root, a)
         for n in names:
-            place[n] = f'{k + 1}_{first[problem.job(n).location]}'
-        apart = [paths[a][b] for a in spots for b in spots if paths[a][b] > 0]
+            place[n] = f'{k + 1}_{_find(root, problem.job(n).location)}'
+        apart = [problem.distance(a, b) for a in spots for b in spots
+                 if _find(root, a) != _find(root, b)]
         if apart:
             least = min(apart) if least is None else min(least, *apart)
     return place, least or Fraction(0)
 
 
-def _shortest_paths(problem: Problem, spots):
-    """Floyd-Warshall over a panel's locations (a dozen on the paper)."""
-    paths = {a: {b: problem.distance(a, b) for b in spots} for a in spots}
-    for via in spots:
-        for a in spots:
-            for b in spots:
-                if paths[a][via] + paths[via][b] < paths[a][b]:
-                    paths[a][b] = paths[a][via] + paths[via][b]
-    return paths
+def _find(root, a):
+    while root[a] != a:
+        a = root[a]
+    return a
