@@ -14,6 +14,7 @@ from fjsp_planner.core.greedy import (
     greedy_schedule,
 )
 from fjsp_planner.core.limits import MAX_WORKERS
+from fjsp_planner.core.load_bound import panel_load_bound
 from fjsp_planner.core.machine_bound import panel_machine_bound
 from fjsp_planner.core.panels import stitched_schedule
 from fjsp_planner.core.problem import Problem
@@ -33,6 +34,9 @@ without the robots that cannot move between panels (`bounds.unhelped_panel`)."""
 MACHINE_SHARE = 0.1
 """Share of the time limit for the panel machine bound (`machine_bound`): 2 panels of the
 paper are solved to its optimum in about 3 s; beyond, it returns what it proved in time."""
+LOAD_SHARE = 0.05
+"""Share of the time limit for the panel load bound (`load_bound`): it proves its optimum on
+2 to 10 panels of the paper in 0.1-1.5 s (2 workers) and then stops."""
 MIN_PANEL_SECONDS = 0.5
 """Below this the one-panel solves' own overhead outweighs their share."""
 HANDOFF_SHARE = 0.5
@@ -95,9 +99,11 @@ def solve(problem: Problem, solver: str = 'cpsat', time_limit: float = 10.0, wor
         if stitched is not None and stitched.makespan < (hint or greedy).makespan:
             hint, notes = stitched, notes + ('started from panels stitched from one-panel '
                                              'optima',)
-        machine = panel_machine_bound(problem, (hint or greedy).makespan,
-                                      MACHINE_SHARE * time_limit, workers)
-        panel_bound = max((b for b in (panel_bound, machine) if b is not None), default=None)
+        incumbent = (hint or greedy).makespan
+        machine = panel_machine_bound(problem, incumbent, MACHINE_SHARE * time_limit, workers)
+        load = panel_load_bound(problem, incumbent, LOAD_SHARE * time_limit, workers)
+        panel_bound = max((b for b in (panel_bound, machine, load) if b is not None),
+                          default=None)
     if solver == 'cpsat' and hint is None and keep is None and greedy is not None and (
             tabu.applies(problem)):
         return _classic(problem, greedy, began, time_limit, workers, notes, log)
@@ -202,9 +208,9 @@ class _Background:
 def _with_panel_bounds(problem: Problem, result: Result, found_before: Fraction | None
                        ) -> Result:
     """The result with its bound raised by the panel decomposition bounds (bounds.py);
-    `found_before` is the best of the one-panel and panel machine bounds found before the
-    search, if any (both hold for schedules shorter than the search's start, hence for all
-    with the minimum taken below)."""
+    `found_before` is the best of the one-panel, panel machine and panel load bounds found
+    before the search, if any (they hold for schedules shorter than the search's start, hence
+    for all with the minimum taken below)."""
     best = result.makespan
     found = [b for b in (bounds.panel_energy_bound(problem, best),
                          bounds.panel_clique_bound(problem, best), found_before)
