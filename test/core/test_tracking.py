@@ -1,6 +1,7 @@
 """The planner's view of execution, from reports, on the paper's instance."""
 
 import contextlib
+import math
 import random
 from fractions import Fraction
 from pathlib import Path
@@ -613,3 +614,27 @@ def test_a_failure_and_recovery_within_one_planner_tick_are_seen(planned):
     assert tracker.failed_since(1) == {'MARC2'}
     tracker.set_plan(schedule, 2)
     assert tracker.failed_since(2) == frozenset() and tracker.failed_since(1) == {'MARC2'}
+
+
+def test_a_restarted_agent_that_reports_no_place_is_where_it_was(planned):
+    """Found by the soak: the Assembler's agent was killed in panel 1 and started again; its
+    new process reported no location, the re-plan placed it anywhere, sent it to a job of
+    panel 2 without its 200-unit crossing, and the executed timeline failed the mission."""
+    problem, schedule = planned
+    tracker = MissionTracker(problem)
+    tracker.set_plan(schedule, 1)
+    last = max((a for a in schedule.jobs.values() if 'Assembler' in a.robots),
+               key=lambda a: a.end)
+    now = float(last.end)
+    run_plan(tracker, schedule, until=now)
+    place = problem.job(last.job).location
+    tracker.record_robot_state('Assembler', 'idle', place, '', math.nan)
+    tracker.record_robot_state('Assembler', 'idle', '', '', math.nan)  # a new agent process
+    assert tracker.execution_state(now).robots['Assembler'].location == place
+    # A planner restarted too knows the robot only from the jobs it did.
+    resumed = MissionTracker(problem)
+    resumed.set_plan(schedule, 1)
+    for name in tracker.done:
+        resumed.restore_done(tracker.jobs[name].done_as)
+    resumed.record_robot_state('Assembler', 'idle', '', '', math.nan)
+    assert resumed.execution_state(now).robots['Assembler'].location == place

@@ -69,6 +69,17 @@ def fleet_is_idle(observer):
                for r in observer.robots.values())
 
 
+def test_an_idle_planner_says_so(idle_fleet):
+    """Before any mission the planner's status is IDLE, so `mission status` (and monitors,
+    and recorders) know it is there rather than time out asking whether it runs."""
+    idle_fleet.wait_for(lambda o: o.status is not None, 30, "the idle planner's status")
+    assert idle_fleet.observer.status.state == MissionStatus.STATE_IDLE
+    assert idle_fleet.observer.status.mission_id == ''
+    done = idle_fleet.run('fjsp_planner', 'mission', 'status', timeout=60)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert done.stdout.strip() == 'idle: no mission yet, the planner waits for one'
+
+
 def test_successive_missions_on_one_fleet(client, observer):
     first = client.run(SCENARIO, timeout=90)
     assert first.complete, first

@@ -7,12 +7,15 @@ The mission runs at 0.1 s per schedule unit so that a failure lands mid-mission.
 
 import json
 import subprocess
+import time
 from pathlib import Path
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from mcap.reader import make_reader
 
 from fjsp_msgs.msg import MissionStatus
+from fjsp_planner.missions import MissionClient
+from fjsp_planner.observe.recording import RecordingError, read_recording
 
 SCENARIO = Path(__file__).resolve().parents[2] / 'config' / 'scenarios' / 'solar_panel.yaml'
 ROBOTS = ('Assembler', 'LSMS', 'MARC1', 'MARC2')
@@ -41,6 +44,20 @@ def wait_until_elapsed(observer, units):
                       and o.status.elapsed >= units, 60, f'schedule time {units}')
 
 
+def heard_by_recorder(path) -> set[str]:
+    """The robots whose states, and 'planner' if its status, the recording holds so far."""
+    heard = set()
+    try:
+        for message in read_recording(path):
+            if message.topic == '/robot_states':
+                heard.add(message.message.robot)
+            elif message.topic == '/mission_status':
+                heard.add('planner')
+    except (RecordingError, OSError):
+        pass  # not written yet
+    return heard
+
+
 def latest_revision(observer) -> int:
     return max(p.revision for p in observer.plans)
 
@@ -52,7 +69,23 @@ def test_recording_replays_into_the_history_the_monitor_built(fjsp_fleet, tmp_pa
     fleet.start_node('recorder', 'fjsp_planner', 'recorder',
                      {'out_dir': out, 'file_name': 'mission.mcap', 'flush_period': 0.5})
     fleet.start_monitor(out_dir=out, web_port=0, exit_on_complete=True, refresh_period=0.2)
-    start_fleet(fleet)
+    fleet.start_planner(scenario='')
+    for robot in ROBOTS:
+        fleet.start_agent(robot)
+    # Discovery between fresh processes can take seconds: a recorder that met the planner
+    # after its second plan revision never got the first (the plan is latched one deep). The
+    # mission starts once the recording holds every robot and the idle planner, and the
+    # monitor has shown every robot.
+    deadline = time.monotonic() + 60
+    while not (heard_by_recorder(out / 'mission.mcap') >= {*ROBOTS, 'planner'}
+               and all(f'  {robot} ' in fleet.log('monitor') for robot in ROBOTS)):
+        assert time.monotonic() < deadline, 'the recorder or the monitor did not hear the fleet'
+        time.sleep(0.2)
+    with MissionClient(domain_id=fleet.domain) as client:
+        client.submit(SCENARIO)
+    fleet.wait_for(lambda o: o.plans and all(
+        r in o.robots and o.robots[r].plan_revision >= 1 for r in ROBOTS), 60,
+        'every agent to follow the first plan')
     wait_until_elapsed(observer, 8)
     fleet.inject_fault('MARC1', 'fail')
     fleet.wait_for(lambda o: latest_revision(o) >= 2, 30, 'a re-plan after the failure')

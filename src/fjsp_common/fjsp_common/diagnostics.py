@@ -89,6 +89,8 @@ def planner_diagnostic(name: str, state: MissionState, *, mission_id: str = '',
         level, message = DiagnosticStatus.ERROR, 'mission failed: ' + '; '.join(blocked)
     elif state == MissionState.BLOCKED:
         level, message = DiagnosticStatus.WARN, 'blocked: ' + '; '.join(blocked)
+    elif state == MissionState.IDLE:
+        level, message = DiagnosticStatus.OK, 'idle: waiting for a mission'
     elif warnings:
         level, message = DiagnosticStatus.WARN, f'{state}, {progress}: ' + '; '.join(warnings)
     else:

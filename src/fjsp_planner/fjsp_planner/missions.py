@@ -411,9 +411,13 @@ def _run(client: MissionClient, args) -> int:
         print(f'{len(jobs)} job(s) added: {", ".join(jobs)}')
         return 0
     from fjsp_common.contract import STATE_FROM_MSG
+    from fjsp_common.vocabulary import MissionState
 
     status = client.status(args.timeout)
     state = STATE_FROM_MSG.get(status.state, f'state {status.state}')
+    if state == MissionState.IDLE:
+        print('idle: no mission yet, the planner waits for one')
+        return 0
     print(f'{state} {status.jobs_done}/{status.jobs_total}  mission {status.mission_id} '
           f'revision {status.plan_revision}')
     for reason in status.blocked_reasons:

@@ -202,6 +202,23 @@ class FleetHarness(Fleet):
                 self.claim.release()
             raise
 
+    def start(self, *, monitor: bool = False, stream_monitor: bool = False,
+              recorder: bool = False) -> 'FleetHarness':
+        """`Fleet.start`, but the planner only once the observer hears every agent: DDS
+        discovery between fresh processes can take seconds, and an observer that met an
+        agent late would never see the states the agent went through before (on its first
+        job, say), which a test may be waiting for."""
+        if recorder:
+            self.start_recorder()
+        if monitor:
+            self.start_monitor(stream=stream_monitor)
+        robots = [r.name for r in self.problem.robots]
+        for robot in robots:
+            self.start_agent(robot)
+        self.wait_for(lambda o: all(r in o.robots for r in robots), 60, 'every agent to report')
+        self.start_planner()
+        return self
+
     def start_node(self, name: str, *args, **kwargs):
         if self.network is not None and name not in self.prefixes:
             self.prefixes[name] = self.network.host(self.host_of(name)).prefix
@@ -220,10 +237,6 @@ class FleetHarness(Fleet):
 
     def restore(self, node: str = PLANNER_NODE) -> None:
         self.network.restore(self.host_of(node))
-
-    def start(self, *, monitor: bool = False, stream_monitor: bool = False) -> 'FleetHarness':
-        super().start(monitor=monitor, stream_monitor=stream_monitor)
-        return self
 
     def wait_for(self, predicate, timeout: float, what: str = 'a condition') -> None:
         """`Observer.wait_for`: `predicate` gets the observer."""

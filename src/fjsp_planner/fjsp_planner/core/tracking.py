@@ -279,7 +279,10 @@ class MissionTracker:
             return Outcome(Ignored.UNKNOWN, problem, repeated=repeated)
         record = self.robots[robot]
         was_healthy = record.healthy
-        record.mode, record.location, record.destination = mode, location, destination
+        # A robot does not leave its place by restarting its agent, whose new process
+        # reports no location until its first leg: the last one reported still holds.
+        record.mode, record.destination = mode, destination
+        record.location = location or record.location
         record.busy_until = busy_until if _time_ok(busy_until) else math.nan
         record.current_job, record.reported = current_job, True
         self._count_failure(record, was_healthy, at)
@@ -455,8 +458,9 @@ class MissionTracker:
                 location, free_at = r.destination, max(Fraction(arrival), now_f)
             else:
                 # An agent reports no location until its first leg places it: until then
-                # it is where the mission starts it.
-                location, free_at = r.location or robot.start_location, now_f
+                # it is where its last job left it (an agent restarted under a planner
+                # restarted too), else where the mission starts it.
+                location, free_at = r.location or self._last_place(name), now_f
             # Nor is it free before its release time, however idle it looks.
             free_at = max(free_at, Fraction(robot.release_time))
             failed_at = None if r.last_failure_at is None else Fraction(r.last_failure_at)
@@ -464,6 +468,14 @@ class MissionTracker:
         done_as = {name: self.jobs[name].done_as for name in self.done
                    if self.jobs[name].done_as is not None}
         return ExecutionState(now_f, self.done, running, robots, done_as)
+
+    def _last_place(self, robot: str) -> str | None:
+        """Where the last job the robot completed is, else where the mission starts it."""
+        done = [a for name in self.done if (a := self.jobs[name].done_as) is not None
+                and robot in a.robots]
+        if not done:
+            return self.problem.robot(robot).start_location
+        return self.problem.job(max(done, key=lambda a: a.end).job).location
 
     def violations(self) -> list[str]:
         """Every way the executed timeline (the jobs done so far, as they ran) breaks the

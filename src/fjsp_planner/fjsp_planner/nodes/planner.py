@@ -725,6 +725,9 @@ class PlannerNode(Node):
     def publish_diagnostics(self) -> None:
         view = self.controller.status(self.wall())
         if view is None:
+            self.diagnostics_pub.publish(diagnostic_array(
+                self.get_clock().now().to_msg(),
+                [planner_diagnostic(f'{self.get_name()}: mission', MissionState.IDLE)]))
             return
         status, gap = self.solver_answer
         self.diagnostics_pub.publish(diagnostic_array(
@@ -764,6 +767,12 @@ class PlannerNode(Node):
     def publish_status(self) -> None:
         view = self.controller.status(self.wall())
         if view is None:
+            # Heard by `mission status`, monitors and recorders before any mission: they
+            # know the planner is there, waiting for one.
+            self.status_pub.publish(self.auth.sign(MissionStatus(
+                stamp=self.get_clock().now().to_msg(),
+                state=STATE_TO_MSG[MissionState.IDLE],
+                ignored_unauthenticated=self.auth.rejected), MISSION_STATUS_TOPIC))
             return
         self.publish_feedback()
         ignored = view.ignored
