@@ -34,7 +34,7 @@ def test_records_round_trip_exactly(tmp_path):
     journal = Journal(path)
     records = [mission(), PlanRecord(1, 12.5, SCHEDULE, frozenset({'Ja'}), ('r',),
                                      {'R1': 'dock', 'R2': None}, {'R1': 7, 'R2': 12}),
-               DoneRecord(ASSIGNMENT, 1), JobsAddedRecord('jobs: []', ('A', 'B')),
+               DoneRecord(ASSIGNMENT, 1, 'planner/17/3'), JobsAddedRecord('jobs: []', ('A', 'B')),
                PlanRecord(2, 12.5, None, frozenset(), ('cancelled',)),
                EndRecord('cancelled', ('by test',))]
     for record in records:

@@ -264,9 +264,17 @@ class FleetHarness(Fleet):
         self.wait_for(lambda o: o.complete(), timeout, 'the mission to complete')
         # The last job-done events and the status saying complete may come in either order;
         # each agent's event history comes when its writer is discovered.
-        self.wait_for(lambda o: o.jobs_done() >= jobs
-                      and operations_reported(o.plans, o.events), 10,
-                      "every job-done event and every robot's operation reports")
+        missing = []
+
+        def reported(o) -> bool:
+            missing[:] = [f"job-done of '{j}'" for j in sorted(jobs - o.jobs_done())]
+            missing.extend(f"{robot}'s operation_done of '{job}'"
+                           for robot, job in unreported_operations(o.plans, o.events))
+            return not missing
+
+        if not Listener.wait_for(self.observer, lambda: reported(self.observer), 10):
+            pytest.fail(f'the mission completed, but 10 s later the observer still lacks '
+                        f'{", ".join(missing)}', pytrace=False)
         with self.observer.lock:
             plans, events = list(self.observer.plans), list(self.observer.events)
             story = list(self.observer.mission_events)
@@ -295,12 +303,18 @@ def operations_reported(plans, events) -> bool:
     the job's last attempt, among `events`. A robot's reports come on its own writer: an
     agent restarted late in a mission may be heard after the planner declared its last job
     done."""
+    return bool(plans) and not unreported_operations(plans, events)
+
+
+def unreported_operations(plans, events) -> list[tuple[str, str]]:
+    """(robot, job) of the operations the last of `plans` gives a robot that `events` do not
+    report done in the job's last attempt (none without a plan)."""
     if not plans:
-        return False
+        return []
     planned = {(r.robot, t.job) for r in plans[-1].robots for t in r.tasks}
     reported = {(e.robot, e.job) for e in valid_events(plans, events)
                 if e.kind == TaskEvent.KIND_OPERATION_DONE}
-    return planned <= reported
+    return sorted(planned - reported)
 
 
 @pytest.fixture

@@ -57,6 +57,10 @@ class PlanRecord:
 class DoneRecord:
     assignment: JobAssignment
     revision: int
+    event_id: str = ''
+    """The id of the job-done event that declared it ('' in older journals): a restarted
+    planner publishes it again, as the event history of the process that sent it died with
+    that process."""
 
 
 @dataclass(frozen=True)
@@ -157,7 +161,7 @@ def _encode(record: Record) -> dict:
                 'starts': dict(record.starts), 'incarnations': dict(record.incarnations)}
     if isinstance(record, DoneRecord):
         return {'type': 'done', 'job': _assignment(record.assignment),
-                'revision': record.revision}
+                'revision': record.revision, 'event_id': record.event_id}
     if isinstance(record, JobsAddedRecord):
         return {'type': 'jobs_added', 'fragment': record.fragment_yaml,
                 'jobs': list(record.jobs)}
@@ -178,7 +182,8 @@ def _decode(data: dict) -> Record:
                           dict(data.get('starts', {})),
                           {robot: int(n) for robot, n in data.get('incarnations', {}).items()})
     if kind == 'done':
-        return DoneRecord(_read_assignment(data['job']), int(data['revision']))
+        return DoneRecord(_read_assignment(data['job']), int(data['revision']),
+                          str(data.get('event_id', '')))
     if kind == 'jobs_added':
         return JobsAddedRecord(data['fragment'], tuple(data['jobs']))
     if kind == 'end':

@@ -329,6 +329,13 @@ class PlannerNode(Node):
         log.warning(f"resuming mission '{head.mission_id}' from {path}")
         self.carry_out(self.controller.resume(head.mission_id, problem, settings,
                                               head.accepted, records[1:], self.wall()))
+        # The previous process's event history died with it, and a completion it published
+        # just before it was killed may never have reached anyone: declared again, with its
+        # own id, so those who heard it recognise it.
+        for record in records:
+            if isinstance(record, DoneRecord) and record.event_id:
+                self.publish_done_event(record.event_id, head.mission_id, record.assignment.job,
+                                        record.revision, float(record.assignment.end))
         return head.origin
 
     def ran_before(self, origin: str) -> bool:
@@ -693,21 +700,25 @@ class PlannerNode(Node):
 
     def publish_job_done(self, effect: JobDone) -> None:
         mission = self.controller.mission
+        self.event_count += 1
+        event_id = f'planner/{self.incarnation}/{self.event_count}'
         if self.journal is not None:
             # On disk before the fleet hears of it: a planner killed after publishing would
             # otherwise rebuild the job from the agents' event histories once restarted, and
             # declare it done a second time.
-            self.journal.write(DoneRecord(effect.assignment, effect.revision))
-        self.event_count += 1
-        event_id = f'planner/{self.incarnation}/{self.event_count}'
-        self.job_done_ids.add(event_id)
-        self.event_pub.publish(self.auth.sign(TaskEvent(
-            stamp=self.get_clock().now().to_msg(), event_id=event_id, mission_id=mission.id,
-            kind=TaskEvent.KIND_JOB_DONE, job=effect.job, plan_revision=effect.revision,
-            time=effect.time), TASK_EVENTS_TOPIC))
+            self.journal.write(DoneRecord(effect.assignment, effect.revision, event_id))
+        self.publish_done_event(event_id, mission.id, effect.job, effect.revision, effect.time)
         tracker = mission.tracker
         self.get_logger().info(f'job {effect.job} done at t={effect.time:.2f} '
                                f'({len(tracker.done)}/{len(tracker.jobs)})')
+
+    def publish_done_event(self, event_id: str, mission_id: str, job: str, revision: int,
+                           time: float) -> None:
+        self.job_done_ids.add(event_id)
+        self.event_pub.publish(self.auth.sign(TaskEvent(
+            stamp=self.get_clock().now().to_msg(), event_id=event_id, mission_id=mission_id,
+            kind=TaskEvent.KIND_JOB_DONE, job=job, plan_revision=revision, time=time),
+            TASK_EVENTS_TOPIC))
 
     def tell(self, note: Note) -> None:
         mission = self.controller.mission
