@@ -80,6 +80,15 @@ class Fleet:
             effects += self.take(self.controller.tick(self.wall))
         return effects
 
+    def tick_until_solve(self, ticks=20):
+        """Tick until the controller asks for one solve (at most `ticks` times); that request."""
+        for _ in range(ticks):
+            requests = kinds(self.tick(), Solve)
+            if requests:
+                (request,) = requests
+                return request
+        raise AssertionError(f'no solve requested within {ticks} ticks')
+
     def run_solves(self, effects=None, improve_too=False):
         """Carry out the pending solves as the node would (a search for a better plan only
         with `improve_too`); the effects of their outcomes."""
@@ -438,12 +447,7 @@ def test_resume_rebuilds_the_mission_and_replans_above_what_robots_follow(proble
         restarted.event(EventKind.OPERATION_DONE, robot, last.job,
                         float(last.start + problem.duration(robot, q)), revision=1)
     assert restarted.controller.mission.tracker.done == mission.tracker.done
-    requests = []
-    for _ in range(20):
-        requests += kinds(restarted.tick(), Solve)
-        if requests:
-            break
-    (request,) = requests
+    request = restarted.tick_until_solve()
     assert len(request.reasons) == 1 and 'planner restarted' in request.reasons[0]
     assert set(request.state.done) == set(mission.tracker.done)
     (published,) = kinds(restarted.run_solves([request]), PublishPlan)
@@ -542,12 +546,7 @@ def test_an_agent_restarted_while_the_planner_was_down_has_its_job_redone(proble
     restarted.heartbeat()
     # The robot that stayed still has its history; the restarted one lost its own.
     restarted.event(EventKind.STARTED, stayed, job.job, float(job.start), revision=1)
-    requests = []
-    for _ in range(20):
-        requests += kinds(restarted.tick(), Solve)
-        if requests:
-            break
-    (request,) = requests
+    request = restarted.tick_until_solve()
     aborted = notes(restarted.effects, MissionEventKind.JOB_ABORTED)
     assert [n.job for n in aborted] == [job.job]
     assert f"robot '{gone}' restarted while the planner was down" in aborted[0].reasons[0]
