@@ -152,9 +152,11 @@ def test_diagnostics_show_failed_and_offline_robots(fjsp_fleet):
     fleet.start_monitor(web_port=0, diagnostics_period=0.3, heartbeat_timeout=0.8)
     start_fleet(fleet)
 
+    # The agents report on /diagnostics too (`agent_MARC1: robot`): what is tested here is
+    # what the monitor says of each robot.
     def reported(robot, level, words):
-        return lambda o: any(s.hardware_id == robot and s.level == level and words in s.message
-                             for s in statuses)
+        return lambda o: any(s.name == f'monitor: robot {robot}' and s.hardware_id == robot
+                             and s.level == level and words in s.message for s in statuses)
 
     fleet.wait_for(reported('Assembler', DiagnosticStatus.OK, ''), 30,
                       'an OK diagnostic of the Assembler')
@@ -164,9 +166,8 @@ def test_diagnostics_show_failed_and_offline_robots(fjsp_fleet):
     fleet.kill('agent_MARC2')
     fleet.wait_for(reported('MARC2', DiagnosticStatus.ERROR, 'offline'), 20,
                       'an ERROR diagnostic of MARC2, killed')
-    failed = next(s for s in statuses if s.hardware_id == 'MARC1'
+    failed = next(s for s in statuses if s.name == 'monitor: robot MARC1'
                   and s.level == DiagnosticStatus.ERROR)
-    assert failed.name == 'monitor: robot MARC1'
     assert {v.key: v.value for v in failed.values}['mode'] == 'failed'
 
 
