@@ -73,7 +73,11 @@ def _in_worker(work) -> int:
 
     worker = threading.Thread(target=run, name='fjsp-solve', daemon=True)
     worker.start()
-    worker.join()
+    # In short waits: a signal the kernel hands to another thread (a worker, a CP-SAT thread)
+    # only flags the main thread, which runs the handler at its next bytecode; blocked in a
+    # join without a timeout it would have none until the worker ended.
+    while worker.is_alive():
+        worker.join(0.1)
     if 'error' in outcome:
         raise outcome['error']
     return outcome['code']
