@@ -250,17 +250,16 @@ class Fleet:
     # --- starting --------------------------------------------------------------------
 
     def start(self, *, monitor: bool = True, stream_monitor: bool = False,
-              recorder: bool = False, planner: bool = True) -> 'Fleet':
-        """The recorder of the mission's topics, the monitor, an agent for every robot of
-        the scenario, and the planner (last: it plans once it hears the agents)."""
+              recorder: bool = False) -> 'Fleet':
+        """The planner, an agent for every robot of the scenario, the monitor, and the
+        recorder of the mission's topics."""
         if recorder:
             self.start_recorder()
         if monitor:
             self.start_monitor(stream=stream_monitor)
+        self.start_planner()
         for robot in self.problem.robots:
             self.start_agent(robot.name)
-        if planner:
-            self.start_planner()
         return self
 
     def start_planner(self, **params) -> subprocess.Popen:

@@ -208,9 +208,13 @@ class FleetHarness(Fleet):
         discovery between fresh processes can take seconds, and an observer that met an
         agent late would never see the states the agent went through before (on its first
         job, say), which a test may be waiting for."""
-        super().start(monitor=monitor, stream_monitor=stream_monitor, recorder=recorder,
-                      planner=False)
+        if recorder:
+            self.start_recorder()
+        if monitor:
+            self.start_monitor(stream=stream_monitor)
         robots = [r.name for r in self.problem.robots]
+        for robot in robots:
+            self.start_agent(robot)
         self.wait_for(lambda o: all(r in o.robots for r in robots), 60, 'every agent to report')
         self.start_planner()
         return self
