@@ -11,6 +11,7 @@ import pytest
 
 from fjsp_common.vocabulary import EventKind, MissionEventKind, MissionState, RobotMode
 from fjsp_planner.core.mission import (
+    IMPROVE_REACH,
     EventReport,
     JobDone,
     MissionController,
@@ -102,7 +103,8 @@ class Fleet:
                 outcome = repair(effect.problem, effect.previous, effect.state,
                                  time_limit=effect.time_limit)
             else:
-                outcome = improve(effect.published, time_limit=effect.time_limit)
+                outcome = improve(effect.published, time_limit=effect.time_limit,
+                                  frozen_until=effect.frozen_until)
             out += self.take(self.controller.solved(effect.token, outcome, self.wall))
         return out
 
@@ -577,11 +579,17 @@ def test_a_repaired_plan_is_published_at_once_then_bettered(problem):
         assert not searches  # nothing to better
         return
     (search,) = searches
+    # The robots go on with the repaired plan until the search's plan can reach them.
+    assert search.frozen_until == pytest.approx(fleet.controller.now_units(
+        fleet.wall + search.time_limit + IMPROVE_REACH))
     better = kinds(fleet.run_solves([search], improve_too=True), PublishPlan)
     for plan in better:
         assert plan.revision == repaired.revision + 1
         assert plan.result.makespan < repaired.result.makespan
         assert plan.reasons[0].startswith('a better plan: makespan')
+        begun = {name for name, a in repaired.result.schedule.jobs.items()
+                 if a.start < search.frozen_until}
+        assert begun <= plan.continued
 
 
 def test_a_better_plan_is_searched_from_again_until_a_search_finds_no_better(problem):

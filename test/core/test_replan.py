@@ -26,6 +26,7 @@ from fjsp_planner.core.replan import (
     ExecutionState,
     RobotState,
     StateError,
+    frozen,
     improve,
     repair,
     replan,
@@ -458,3 +459,54 @@ def test_repair_keeps_the_previous_plan_when_it_still_works(paper):
     repaired = repair(problem, plan, simulated_state(problem, plan, last[robot] + 1, {robot}))
     assert repaired.problems == []
     assert repaired.schedule.makespan == 32
+
+
+@pytest.fixture(scope='module')
+def repaired_paper(paper):
+    """The paper's optimal plan repaired after MARC1 fails at 3, and when a search started
+    then would reach the robots (6 later)."""
+    problem, plan = paper
+    now = Fraction(3)
+    repaired = repair(problem, plan, simulated_state(problem, plan, now, {'MARC1'}))
+    assert repaired.problems == []
+    return repaired, now + 6
+
+
+def test_frozen_keeps_what_the_robots_do_until_a_new_plan_reaches_them(repaired_paper):
+    repaired, until = repaired_paper
+    schedule = repaired.schedule
+    posed = frozen(repaired.residual, schedule, until).problem
+    begun = {name for name, a in schedule.jobs.items() if a.start < until}
+    assert begun and begun <= set(posed.fixed)
+    assert set(posed.fixed) < set(schedule.jobs), 'everything frozen: nothing to search'
+    for name, kept in posed.fixed.items():
+        a = schedule.jobs[name]
+        assert (kept.plan, kept.start, kept.end, dict(kept.robots)) == (
+            a.plan, a.start, a.end, dict(a.robots))
+    for sequence in schedule.sequences.values():
+        # A robot's kept jobs come first: nothing new can be planned before them.
+        flags = [name in posed.fixed for name in sequence]
+        assert flags == sorted(flags, reverse=True)
+    for robot in posed.robots:
+        assert robot.release_time >= until
+        for visit in schedule.visits(posed, robot.name):
+            if visit.travel_start < until:  # on its way there when the plan arrives
+                assert visit.job in posed.fixed
+    assert validate(posed, schedule) == []
+
+
+def test_improve_from_a_frozen_plan_starts_nothing_new_before_it_reaches_the_robots(
+        repaired_paper):
+    """The better plan keeps the jobs the robots do meanwhile as they are, so the planner
+    can publish it after they moved on; with the part executed before the failure it is a
+    schedule of the paper's instance, so it cannot beat 32."""
+    repaired, until = repaired_paper
+    better = improve(repaired, time_limit=3.0, margin=0, frozen_until=until)
+    posed, schedule = better.replan.residual.problem, better.replan.schedule
+    assert validate(posed, schedule) == []
+    for name, a in repaired.schedule.jobs.items():
+        if name in posed.fixed:
+            assert schedule.jobs[name] == a
+        else:
+            assert schedule.jobs[name].start >= until
+    assert 32 <= schedule.makespan <= repaired.schedule.makespan

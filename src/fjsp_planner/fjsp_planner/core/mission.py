@@ -43,6 +43,10 @@ LONGEST_SEARCH = 16
 """The longest search for a better plan, in `replan_time_limit`s: searches that find nothing
 better double in length up to it (1, 2, 4, 8, 16 s by default), then stop."""
 
+IMPROVE_REACH = 0.5
+"""Seconds beyond a search's time limit until its plan reaches the robots (the solver's
+overrun, publishing, the agents taking it): what they do by then is kept in it."""
+
 RETRY_FAILED_REPLAN = 1.0
 """Seconds after which a re-plan that failed is tried again, if no new report came first."""
 
@@ -119,6 +123,9 @@ class Solve:
     """Why a re-plan is needed."""
     published: Replan | None = None
     """For 'improve': the repaired plan to search from."""
+    frozen_until: float | None = None
+    """For 'improve': the schedule time by which its plan reaches the robots; what the
+    published plan has them do until then is kept (`replan.frozen`)."""
 
 
 @dataclass(frozen=True)
@@ -661,15 +668,17 @@ class MissionController:
         mission.solving = _Solving(self._tokens, kind, problem, fleet, reasons, state)
         return Solve(self._tokens, kind, problem, time_limit, previous, state, reasons)
 
-    def _improve(self, mission, solving: _Solving, published: Replan,
+    def _improve(self, mission, solving: _Solving, published: Replan, wall: float,
                  time_limit: float | None = None) -> Solve:
-        """Search for a better plan from the one just published, while it is followed."""
+        """Search for a better plan from the one just published, while it is followed: the
+        robots go on with what it has them do until the search's plan can reach them."""
         self._tokens += 1
         limit = time_limit or mission.settings.replan_time_limit
         mission.improving = replace(solving, token=self._tokens, kind='improve',
                                     time_limit=limit)
         return Solve(self._tokens, 'improve', published.residual.problem, limit,
-                     state=solving.state, reasons=solving.reasons, published=published)
+                     state=solving.state, reasons=solving.reasons, published=published,
+                     frozen_until=self._now(mission, wall + limit + IMPROVE_REACH))
 
     def solved(self, token: int, outcome, wall: float) -> list[Effect]:
         """The outcome of `Solve` `token`: a `Result` ('plan'), a `Replan` ('replan'), or
@@ -766,7 +775,7 @@ class MissionController:
                                   continued | frozenset(progressed), solving.reasons)
         if result.status == Status.OPTIMAL:
             return notes + published
-        return notes + published + [self._improve(mission, solving, replanned)]
+        return notes + published + [self._improve(mission, solving, replanned, wall)]
 
     def _improved(self, mission, solving: _Solving, outcome, wall: float) -> list[Effect]:
         """A better plan than the repaired one, published as the next revision if it beats
@@ -787,7 +796,7 @@ class MissionController:
             proven = kept.lower_bound is not None and kept.lower_bound >= kept.makespan
             if proven or longer > LONGEST_SEARCH * mission.settings.replan_time_limit:
                 return []
-            return [self._improve(mission, solving, outcome.replan, longer)]
+            return [self._improve(mission, solving, outcome.replan, wall, longer)]
         better = outcome.replan
         continued = frozenset(better.residual.problem.fixed)
         progressed = self._progressed(mission, solving.state, better.residual.problem)
@@ -799,7 +808,8 @@ class MissionController:
                                   continued | frozenset(progressed), (reason,))
         if better.result.status == Status.OPTIMAL:
             return published
-        return published + [self._improve(mission, solving, better, solving.time_limit)]
+        return published + [self._improve(mission, solving, better, wall,
+                                          solving.time_limit)]
 
     def _progressed(self, mission, posed_state: ExecutionState, posed: Problem) -> list[str]:
         """Jobs the new plan starts afresh that started or completed since it was posed."""

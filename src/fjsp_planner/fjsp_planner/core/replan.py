@@ -226,19 +226,24 @@ IMPROVE_MARGIN = 0.02
 
 
 def improve(published: Replan, time_limit: float = 2.0, workers: int = 2,
-            margin: float = IMPROVE_MARGIN) -> Improvement:
+            margin: float = IMPROVE_MARGIN, frozen_until=None) -> Improvement:
     """The second stage of anytime re-planning: search from the published plan.
 
     CP-SAT starts from `published` (a `repair` or earlier `improve` outcome) and, among the
     shortest schedules it finds, prefers those moving the fewest robots off it. `improved`
     says whether the result beats the published makespan by more than `margin` (a share).
-    The residual problem is the published one's, posed at the failure's time: jobs the
-    agents finished meanwhile stay in it, so re-pose with `repair` before publishing if the
-    mission moved on far.
+
+    The robots follow `published` while the search runs. `frozen_until` (schedule time) is
+    when the search's plan can reach them: what `published` has them do by then is kept as
+    it is (`frozen`), and nothing else starts before it, so the better plan still fits what
+    they did meanwhile. Without it the residual is the published one, posed at the failure's
+    time: a plan that changes jobs the robots have started since cannot be followed.
     """
     residual = published.residual
     if residual.problem is None or published.schedule is None:
         return Improvement(published, False)
+    if frozen_until is not None:
+        residual = frozen(residual, published.schedule, Fraction(frozen_until))
     result = solve(residual.problem, time_limit=time_limit, workers=workers,
                    hint=published.schedule, keep=published.schedule)
     if result.schedule is None or validate(residual.problem, result.schedule):
@@ -250,6 +255,37 @@ def improve(published: Replan, time_limit: float = 2.0, workers: int = 2,
             published.result.lower_bound or 0, result.lower_bound or 0))
         return Improvement(Replan(residual, kept, published.problems), False)
     return Improvement(Replan(residual, result, []), True)
+
+
+def frozen(residual: Residual, schedule: Schedule, until: Fraction) -> Residual:
+    """`residual` with what `schedule` has the robots do before `until` fixed as it is.
+
+    A job is kept when it starts before `until` or one of its robots sets off for it before
+    then, and so is every job a robot does before a kept one (a robot's fixed jobs come
+    first in its sequence). The robots are released at `until` for anything else, so no
+    other job starts before it. `schedule` stays valid for the result.
+    """
+    problem = residual.problem
+    kept = set(problem.fixed)
+    for robot in problem.robots:
+        for visit in schedule.visits(problem, robot.name):
+            if visit.start < until or visit.travel_start < until:
+                kept.add(visit.job)
+    grew = True
+    while grew:
+        grew = False
+        for sequence in schedule.sequences.values():
+            last = max((i for i, job in enumerate(sequence) if job in kept), default=-1)
+            before = set(sequence[:last + 1]) - kept
+            if before:
+                kept |= before
+                grew = True
+    fixed = dict(problem.fixed)
+    for name in kept - set(fixed):
+        a = schedule.jobs[name]
+        fixed[name] = FixedJob(a.plan, a.start, a.end, dict(a.robots))
+    robots = tuple(replace(r, release_time=max(r.release_time, until)) for r in problem.robots)
+    return replace(residual, problem=replace(problem, fixed=fixed, robots=robots))
 
 
 def _project(residual: Problem, previous: Schedule) -> Schedule | None:

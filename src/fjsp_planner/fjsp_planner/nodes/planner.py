@@ -610,7 +610,8 @@ class PlannerNode(Node):
                                       request.state, time_limit=request.time_limit)
         else:
             future = self.pool.submit(improve, request.published,
-                                      time_limit=request.time_limit, workers=workers)
+                                      time_limit=request.time_limit, workers=workers,
+                                      frozen_until=request.frozen_until)
         self.solves[request.token] = future
         future.add_done_callback(self.wake)
 
