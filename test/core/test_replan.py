@@ -492,6 +492,10 @@ def test_frozen_keeps_what_the_robots_do_until_a_new_plan_reaches_them(repaired_
         for visit in schedule.visits(posed, robot.name):
             if visit.travel_start < until:  # on its way there when the plan arrives
                 assert visit.job in posed.fixed
+        # A kept job the robot has not reached yet keeps its leg: the agent travels it.
+        legs = [v.arrival - v.travel_start for v in schedule.visits(posed, robot.name)]
+        assert legs == [v.arrival - v.travel_start for v in schedule.visits(
+            repaired.residual.problem, robot.name)]
     assert validate(posed, schedule) == []
 
 

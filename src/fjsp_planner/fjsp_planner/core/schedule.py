@@ -47,10 +47,14 @@ class Schedule:
         for name in self.sequences[robot]:
             a = self.jobs[name]
             here = problem.job(name).location
-            if name in problem.fixed or location is None:
+            if location is None:
                 leg, free_at = Fraction(0), a.start
             else:
                 leg = problem.travel(robot, location, here)
+                if name in problem.fixed:
+                    # Kept as planned before: running (the robot is there, released at its
+                    # end) or frozen (`replan.frozen`), the robot set off in time for it.
+                    free_at = min(free_at, a.start - leg)
             visits.append(Visit(name, free_at, free_at + leg, a.start, a.end))
             location, free_at = here, a.end
         return visits
