@@ -21,7 +21,7 @@ from fjsp_planner.core.mission import (
     Settings,
     Solve,
 )
-from fjsp_planner.core.replan import Improvement, improve, repair
+from fjsp_planner.core.replan import Improvement, Replan, improve, repair
 from fjsp_planner.core.scenario import load_scenario
 from fjsp_planner.core.solve import solve
 
@@ -104,7 +104,7 @@ class Fleet:
                                  time_limit=effect.time_limit)
             else:
                 outcome = improve(effect.published, time_limit=effect.time_limit,
-                                  frozen_until=effect.frozen_until)
+                                  frozen_until=effect.frozen_until, started=effect.started)
             out += self.take(self.controller.solved(effect.token, outcome, self.wall))
         return out
 
@@ -617,6 +617,38 @@ def test_a_better_plan_is_searched_from_again_until_a_search_finds_no_better(pro
         (again,) = searches
         limits.append(again.time_limit)
     assert limits == [4.0, 8.0, 16.0, 32.0]
+
+
+def test_a_better_plan_that_changes_what_the_robots_started_meanwhile_is_dropped(problem):
+    """Robots may start jobs ahead of the plan, beyond what the search kept as it is. A
+    plan that gives one of those to other robots cannot be followed: it is dropped with a
+    warning, and a search twice as long starts from the published plan. The search's
+    outcome is made up so that it does change such a job."""
+    fleet, repaired, effects = repaired_after_a_failure(problem)
+    (search,) = [e for e in kinds(effects, Solve) if e.kind == 'improve']
+    published = search.published
+    fleet.wall += 10
+    fleet.execute(until=12)
+    moved = next(name for name, a in sorted(published.schedule.jobs.items(),
+                                            key=lambda kv: kv[1].start)
+                 if name not in published.residual.problem.fixed
+                 and fleet.controller.mission.tracker.jobs[name].started)
+    job = published.schedule.jobs[moved]
+    other = next(r for r in ROBOTS if r not in job.robots and r != 'MARC1')
+    robots = dict(job.robots)
+    robots[other] = robots.pop(next(iter(robots)))
+    changed = replace(published.schedule, jobs={**published.schedule.jobs,
+                                                moved: replace(job, robots=robots)})
+    better = Replan(published.residual, replace(published.result, schedule=changed), [])
+    effects = fleet.take(fleet.controller.solved(search.token, Improvement(better, True),
+                                                 fleet.wall))
+    assert not kinds(effects, PublishPlan)
+    (warning,) = notes(effects, MissionEventKind.WARNING)
+    assert 'dropped' in warning.reasons[0] and f"job '{moved}'" in warning.reasons[0]
+    (again,) = [e for e in kinds(effects, Solve) if e.kind == 'improve']
+    assert again.published is published
+    assert again.time_limit == 2 * search.time_limit
+    assert moved in again.started
 
 
 def test_a_search_for_a_better_plan_is_dropped_when_the_fleet_changes(problem):

@@ -499,6 +499,22 @@ def test_frozen_keeps_what_the_robots_do_until_a_new_plan_reaches_them(repaired_
     assert validate(posed, schedule) == []
 
 
+def test_frozen_keeps_the_jobs_robots_started_ahead_of_the_plan(repaired_paper):
+    """Robots start a job as soon as its robots and predecessors are ready, which can be
+    before the plan's time: what they started stays as it is, with what comes before it."""
+    repaired, until = repaired_paper
+    schedule = repaired.schedule
+    by_time = frozen(repaired.residual, schedule, until).problem
+    ahead = min((name for name in schedule.jobs if name not in by_time.fixed),
+                key=lambda name: schedule.jobs[name].start)
+    posed = frozen(repaired.residual, schedule, until, started={ahead}).problem
+    assert set(by_time.fixed) | {ahead} <= set(posed.fixed)
+    for robot in schedule.jobs[ahead].robots:
+        sequence = schedule.sequences[robot]
+        assert set(sequence[:sequence.index(ahead)]) <= set(posed.fixed)
+    assert validate(posed, schedule) == []
+
+
 def test_improve_from_a_frozen_plan_starts_nothing_new_before_it_reaches_the_robots(
         repaired_paper):
     """The better plan keeps the jobs the robots do meanwhile as they are, so the planner

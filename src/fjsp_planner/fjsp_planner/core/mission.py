@@ -126,6 +126,8 @@ class Solve:
     frozen_until: float | None = None
     """For 'improve': the schedule time by which its plan reaches the robots; what the
     published plan has them do until then is kept (`replan.frozen`)."""
+    started: frozenset[str] = frozenset()
+    """For 'improve': the jobs the robots have started or done; they are kept too."""
 
 
 @dataclass(frozen=True)
@@ -233,6 +235,8 @@ class _Solving:
     state: ExecutionState | None = None
     time_limit: float = 0.0
     """For a search for a better plan: its time limit."""
+    published: Replan | None = None
+    """For a search for a better plan: the published plan it searches from."""
 
 
 @dataclass
@@ -675,10 +679,15 @@ class MissionController:
         self._tokens += 1
         limit = time_limit or mission.settings.replan_time_limit
         mission.improving = replace(solving, token=self._tokens, kind='improve',
-                                    time_limit=limit)
+                                    time_limit=limit, published=published)
+        # Robots start a job as soon as its robots and predecessors are ready, so they may
+        # be ahead of the plan: what they started is kept too.
+        started = frozenset(name for name, record in mission.tracker.jobs.items()
+                            if record.started or record.end is not None)
         return Solve(self._tokens, 'improve', published.residual.problem, limit,
                      state=solving.state, reasons=solving.reasons, published=published,
-                     frozen_until=self._now(mission, wall + limit + IMPROVE_REACH))
+                     frozen_until=self._now(mission, wall + limit + IMPROVE_REACH),
+                     started=started)
 
     def solved(self, token: int, outcome, wall: float) -> list[Effect]:
         """The outcome of `Solve` `token`: a `Result` ('plan'), a `Replan` ('replan'), or
@@ -792,16 +801,19 @@ class MissionController:
             return []
         if not outcome.improved:
             kept = outcome.replan.result
-            longer = 2 * solving.time_limit
-            proven = kept.lower_bound is not None and kept.lower_bound >= kept.makespan
-            if proven or longer > LONGEST_SEARCH * mission.settings.replan_time_limit:
+            if kept.lower_bound is not None and kept.lower_bound >= kept.makespan:
                 return []
-            return [self._improve(mission, solving, outcome.replan, wall, longer)]
+            return self._search_longer(mission, solving, outcome.replan, wall)
         better = outcome.replan
         continued = frozenset(better.residual.problem.fixed)
         progressed = self._progressed(mission, solving.state, better.residual.problem)
         if progressed and not self._goes_on(mission, better.schedule, progressed, continued):
-            return []
+            # The robots got further than the search kept: the plan cannot be followed.
+            dropped = Note(MissionEventKind.WARNING, (
+                f'a better plan (makespan {float(better.result.makespan):.2f}) dropped: '
+                + ', '.join(f"job '{j}'" for j in progressed)
+                + ' progressed while it was searched for',))
+            return [dropped] + self._search_longer(mission, solving, solving.published, wall)
         reason = (f'a better plan: makespan {mission.planned_makespan:.2f} -> '
                   f'{float(better.result.makespan):.2f}')
         published = self._publish(mission, better.residual.problem, better.result,
@@ -810,6 +822,15 @@ class MissionController:
             return published
         return published + [self._improve(mission, solving, better, wall,
                                           solving.time_limit)]
+
+    def _search_longer(self, mission, solving: _Solving, published: Replan, wall: float
+                       ) -> list[Effect]:
+        """After a search that gave no plan to publish: one twice as long from `published`,
+        up to LONGEST_SEARCH times `replan_time_limit`."""
+        longer = 2 * solving.time_limit
+        if longer > LONGEST_SEARCH * mission.settings.replan_time_limit:
+            return []
+        return [self._improve(mission, solving, published, wall, longer)]
 
     def _progressed(self, mission, posed_state: ExecutionState, posed: Problem) -> list[str]:
         """Jobs the new plan starts afresh that started or completed since it was posed."""

@@ -226,7 +226,8 @@ IMPROVE_MARGIN = 0.02
 
 
 def improve(published: Replan, time_limit: float = 2.0, workers: int = 2,
-            margin: float = IMPROVE_MARGIN, frozen_until=None) -> Improvement:
+            margin: float = IMPROVE_MARGIN, frozen_until=None,
+            started=frozenset()) -> Improvement:
     """The second stage of anytime re-planning: search from the published plan.
 
     CP-SAT starts from `published` (a `repair` or earlier `improve` outcome) and, among the
@@ -236,14 +237,15 @@ def improve(published: Replan, time_limit: float = 2.0, workers: int = 2,
     The robots follow `published` while the search runs. `frozen_until` (schedule time) is
     when the search's plan can reach them: what `published` has them do by then is kept as
     it is (`frozen`), and nothing else starts before it, so the better plan still fits what
-    they did meanwhile. Without it the residual is the published one, posed at the failure's
-    time: a plan that changes jobs the robots have started since cannot be followed.
+    they did meanwhile; so are the `started` jobs (robots may be ahead of the plan). Without
+    it the residual is the published one, posed at the failure's time: a plan that changes
+    jobs the robots have started since cannot be followed.
     """
     residual = published.residual
     if residual.problem is None or published.schedule is None:
         return Improvement(published, False)
     if frozen_until is not None:
-        residual = frozen(residual, published.schedule, Fraction(frozen_until))
+        residual = frozen(residual, published.schedule, Fraction(frozen_until), started)
     result = solve(residual.problem, time_limit=time_limit, workers=workers,
                    hint=published.schedule, keep=published.schedule)
     if result.schedule is None or validate(residual.problem, result.schedule):
@@ -257,16 +259,18 @@ def improve(published: Replan, time_limit: float = 2.0, workers: int = 2,
     return Improvement(Replan(residual, result, []), True)
 
 
-def frozen(residual: Residual, schedule: Schedule, until: Fraction) -> Residual:
+def frozen(residual: Residual, schedule: Schedule, until: Fraction, started=frozenset()
+           ) -> Residual:
     """`residual` with what `schedule` has the robots do before `until` fixed as it is.
 
-    A job is kept when it starts before `until` or one of its robots sets off for it before
-    then, and so is every job a robot does before a kept one (a robot's fixed jobs come
-    first in its sequence). The robots are released at `until` for anything else, so no
-    other job starts before it. `schedule` stays valid for the result.
+    A job is kept when it starts before `until`, one of its robots sets off for it before
+    then, or it is one of the `started` jobs, and so is every job a robot does before a kept
+    one (a robot's fixed jobs come first in its sequence). The robots are released at
+    `until` for anything else, so no other job starts before it. `schedule` stays valid for
+    the result.
     """
     problem = residual.problem
-    kept = set(problem.fixed)
+    kept = set(problem.fixed) | (set(started) & set(schedule.jobs))
     for robot in problem.robots:
         for visit in schedule.visits(problem, robot.name):
             if visit.start < until or visit.travel_start < until:

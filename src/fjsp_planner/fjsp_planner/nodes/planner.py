@@ -611,7 +611,8 @@ class PlannerNode(Node):
         else:
             future = self.pool.submit(improve, request.published,
                                       time_limit=request.time_limit, workers=workers,
-                                      frozen_until=request.frozen_until)
+                                      frozen_until=request.frozen_until,
+                                      started=request.started)
         self.solves[request.token] = future
         future.add_done_callback(self.wake)
 
