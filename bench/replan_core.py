@@ -6,9 +6,11 @@ seeded random times into its on-plan execution (`simulated_state`), and time `re
 (residual problem + CP-SAT warm-started from and kept close to the plan + validation), and
 `repair()` (the anytime scheme's first stage: greedy or the previous plan, no search).
 On the --cold earliest faults, the same residual problem is also solved cold (no hint, no
-keep) for --cold-limit seconds, to see what the re-plan's short time limit costs.
+keep) for --cold-limit seconds, to see what the re-plan's short time limit costs, and
+searched from the repaired plan as the planner does (`improve()`), once with the robots
+standing still and once following the published plan at --time-scale seconds per unit.
 
-Prints figures and never asserts. Default run: 5 to 9 minutes on 2 cores.
+Prints figures and never asserts. Default run: 6 to 10 minutes on 2 cores.
 
     ros2_ws/.venv/bin/python bench/replan_core.py [--panels 1 2 5] [--faults 20]
 """
@@ -24,7 +26,7 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO / 'src' / 'fjsp_planner'))
 
-from fjsp_planner.core.mission import LONGEST_SEARCH  # noqa: E402
+from fjsp_planner.core.mission import IMPROVE_REACH, LONGEST_SEARCH  # noqa: E402
 from fjsp_planner.core.replan import improve, repair, replan, simulated_state  # noqa: E402
 from fjsp_planner.core.scenario import load_scenario  # noqa: E402
 from fjsp_planner.core.solve import solve  # noqa: E402
@@ -54,6 +56,9 @@ def main():
                              'the plan by the margin by one as long, one that does not by '
                              'one twice as long, up to LONGEST_SEARCH times this (default '
                              "%(default)s, the planner's replan_time_limit)")
+    parser.add_argument('--time-scale', type=float, default=1.0,
+                        help='seconds per schedule unit as the robots follow the published '
+                             'plan during the frozen searches (default %(default)s)')
     args = parser.parse_args()
 
     began = time.monotonic()
@@ -102,33 +107,48 @@ def bench_panels(panels, args):
         replanned.append((now, robot, outcome, repaired))
     # The earliest faults leave the most to re-plan: those are the ones worth comparing.
     for now, robot, outcome, repaired in sorted(replanned, key=lambda row: row[0])[:args.cold]:
-        t0 = time.monotonic()
-        current, rounds, limit = repaired, 0, args.improve_limit
-        while True:
-            better = improve(current, time_limit=limit, workers=args.workers)
-            if better.improved:
-                current, rounds = better.replan, rounds + 1
-                continue
-            kept = better.replan.result
-            if kept.lower_bound is not None and kept.lower_bound >= kept.makespan or (
-                    2 * limit > LONGEST_SEARCH * args.improve_limit):
-                break
-            limit *= 2
-        improve_seconds = time.monotonic() - t0
+        improved = searches(repaired, args)
+        frozen = searches(repaired, args, now)
         t0 = time.monotonic()
         fresh = solve(outcome.residual.problem, time_limit=args.cold_limit,
                       workers=args.workers)
         cold.append(dict(
             panels=panels, now=now, robot=robot, replan=outcome.result.makespan,
             repaired=repaired.result.makespan if repaired.result else None,
-            improved=current.schedule.makespan if current.schedule else None,
-            improve_seconds=improve_seconds, rounds=rounds,
+            improved=improved, frozen=frozen,
             replan_moves=moves(plan.schedule, outcome), cold=fresh.makespan,
             cold_bound=fresh.lower_bound, cold_status=fresh.status,
             cold_seconds=time.monotonic() - t0,
             cold_moves=moves(plan.schedule, outcome, fresh.schedule)))
     return dict(panels=panels, plan=makespan, limit=limit, latencies=latencies,
                 delays=delays, statuses=statuses, repairs=repairs), cold
+
+
+def searches(repaired, args, now=None):
+    """The planner's searches for a better plan after a repair: (makespan, seconds in all,
+    how many bettered the plan). Each search that betters the plan by the margin is
+    followed by one as long, one that does not by one twice as long, up to LONGEST_SEARCH
+    times the first. With `now`, the failure's schedule time, the robots follow the
+    published plan meanwhile at --time-scale seconds per unit, and each search keeps what
+    they do until its plan can reach them, as the planner has it (`frozen_until`)."""
+    began = time.monotonic()
+    current, rounds, limit = repaired, 0, args.improve_limit
+    while True:
+        until = None
+        if now is not None:
+            until = float(now) + (time.monotonic() - began + limit + IMPROVE_REACH) / (
+                args.time_scale)
+        better = improve(current, time_limit=limit, workers=args.workers, frozen_until=until)
+        current = better.replan  # frozen: its residual keeps what the robots did meanwhile
+        if better.improved:
+            rounds += 1
+            continue
+        kept = current.result
+        if kept.lower_bound is not None and kept.lower_bound >= kept.makespan or (
+                2 * limit > LONGEST_SEARCH * args.improve_limit):
+            break
+        limit *= 2
+    return current.schedule.makespan, time.monotonic() - began, rounds
 
 
 def moves(previous, outcome, schedule=None):
@@ -160,21 +180,30 @@ def print_summary(summary):
 
 def print_comparisons(rows, cold_limit):
     print(f'\nre-plan vs cold solve ({cold_limit:g} s, no hint, no keep) of the same residual')
-    print('panels  robot      at      repair   re-plan  moves  improved (s, n)      cold     '
-          'bound    status    cold s  moves  re-plan vs cold  improve vs cold')
+    print('panels  robot      at      repair   re-plan  moves  improved (s, n)      '
+          'frozen (s, n)        cold     bound    status    cold s  moves  re-plan vs cold  '
+          'improved vs cold  frozen vs cold')
     for c in rows:
-        bound = float(c['cold_bound']) if c['cold_bound'] is not None else float('nan')
-        cold = float(c['cold']) if c['cold'] is not None else float('nan')
-        repaired = float(c['repaired']) if c['repaired'] is not None else float('nan')
-        improved = float(c['improved']) if c['improved'] is not None else float('nan')
-        print(f"{c['panels']:>6}  {c['robot']:9}  {float(c['now']):6.1f}  {repaired:7.2f}  "
-              f"{float(c['replan']):7.2f}  {c['replan_moves']:5}  {improved:7.2f} "
-              f"({c['improve_seconds']:4.1f}, {c['rounds']})  {cold:7.2f}  {bound:7.2f}  "
-              f"{c['cold_status']:8}  {c['cold_seconds']:6.1f}  {c['cold_moves']:5}  "
+        def number(value):
+            return float(value) if value is not None else float('nan')
+
+        cold = number(c['cold'])
+        improved, improve_seconds, improve_rounds = c['improved']
+        frozen, frozen_seconds, frozen_rounds = c['frozen']
+        print(f"{c['panels']:>6}  {c['robot']:9}  {float(c['now']):6.1f}  "
+              f"{number(c['repaired']):7.2f}  {float(c['replan']):7.2f}  "
+              f"{c['replan_moves']:5}  {number(improved):7.2f} "
+              f"({improve_seconds:4.1f}, {improve_rounds})  {number(frozen):7.2f} "
+              f"({frozen_seconds:4.1f}, {frozen_rounds})  {cold:7.2f}  "
+              f"{number(c['cold_bound']):7.2f}  {c['cold_status']:8}  "
+              f"{c['cold_seconds']:6.1f}  {c['cold_moves']:5}  "
               f"{100 * (float(c['replan']) - cold) / cold:+14.1f}%  "
-              f"{100 * (improved - cold) / cold:+14.1f}%")
+              f"{100 * (number(improved) - cold) / cold:+15.1f}%  "
+              f"{100 * (number(frozen) - cold) / cold:+13.1f}%")
     print('moves: (job, robot) assignments of the re-planned jobs not in the previous plan; '
-          'improved: after all searches (seconds in all, n of them bettered the plan)')
+          'improved: after all searches (seconds in all, n of them bettered the plan), the '
+          'robots standing still; frozen: the same while they follow the published plan, '
+          "each search keeping what they do until its plan reaches them (the planner's way)")
 
 
 if __name__ == '__main__':
