@@ -328,7 +328,10 @@ def check_execution(problem, plans, events, complete: bool) -> list[str]:
     jobs = {j.name for j in problem.jobs}
     if complete:
         problems += [f"job '{j}' never done" for j in sorted(jobs - set(done))]
-    executed = executed_timeline(problem, plans, events)
+    try:
+        executed = executed_timeline(problem, plans, events)
+    except AssertionError as error:
+        return problems + [str(error)]
     unreported = sorted(set(done) - set(executed.jobs))
     problems += [f"job '{j}' declared done without its robots' reports" for j in unreported]
     kept = set(executed.jobs) & set(done)

@@ -392,14 +392,20 @@ def valid_events(plans, events) -> list[TaskEvent]:
 def executed_timeline(problem: Problem, plans, events) -> Schedule:
     """The schedule the robots actually ran, rebuilt from their task events alone (the last
     attempt of each job), with each robot's operation as the plans that ran it gave it.
-    Jobs not (yet) finished by all their robots are left out."""
+    Jobs not (yet) finished by all their robots are left out. AssertionError if a robot
+    started a job no plan of `plans` gives it: it followed a plan they miss."""
     started, operation_done = defaultdict(dict), defaultdict(dict)
+    tasks = {(r.robot, t.job): t for plan in plans for r in plan.robots for t in r.tasks}
     for e in valid_events(plans, events):
         if e.kind == TaskEvent.KIND_STARTED:
+            if (e.robot, e.job) not in tasks:
+                raise AssertionError(
+                    f"robot '{e.robot}' started job '{e.job}' under plan revision "
+                    f'{e.plan_revision}, but no plan received (revisions '
+                    f'{sorted({p.revision for p in plans})}) gives it that job')
             started[e.job][e.robot] = e.time
         elif e.kind == TaskEvent.KIND_OPERATION_DONE:
             operation_done[e.job][e.robot] = e.time
-    tasks = {(r.robot, t.job): t for plan in plans for r in plan.robots for t in r.tasks}
     jobs = {}
     for job, robots in started.items():
         if set(operation_done[job]) != set(robots):
