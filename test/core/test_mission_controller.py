@@ -12,11 +12,13 @@ import pytest
 from fjsp_common.vocabulary import EventKind, MissionEventKind, MissionState, RobotMode
 from fjsp_planner.core.mission import (
     IMPROVE_REACH,
+    PLAN_RESEND_AFTER,
     EventReport,
     JobDone,
     MissionController,
     Note,
     PublishPlan,
+    ResendPlan,
     RobotReport,
     Settings,
     Solve,
@@ -50,6 +52,10 @@ class Fleet:
         self.refusals = dict.fromkeys(ROBOTS, '')
         self.following = {}
         """Fields every report of the robots repeats, e.g. the mission they follow."""
+        self.deaf = set()
+        """Robots whose agents take no plan any more: they report the last one they took."""
+        self.taken = {}
+        """Robot -> (mission, revision) of the latest plan its agent took."""
         self.events = 0
 
     def take(self, effects):
@@ -62,9 +68,14 @@ class Fleet:
     def report(self, robot, mode=None, **fields):
         if mode is not None:
             self.modes[robot] = mode
+        mission = self.controller.mission
+        if robot not in self.deaf and mission is not None and mission.tracker.revision:
+            self.taken[robot] = (mission.id, mission.tracker.revision)
+        mission_id, revision = self.taken.get(robot, ('', 0))
         report = RobotReport(robot, self.modes[robot], incarnation=self.incarnations[robot],
                              failures=self.failures[robot], refusal=self.refusals[robot],
-                             **{**self.following, **fields})
+                             **{'mission_id': mission_id, 'revision': revision,
+                                **self.following, **fields})
         return self.take(self.controller.robot_state(report, self.wall))
 
     def heartbeat(self, robots=ROBOTS):
@@ -239,6 +250,43 @@ def test_a_refusing_agent_is_left_out_and_named(problem):
     fleet.run_solves()
     assert fleet.state() == MissionState.EXECUTING
     assert any('refuses its plan' in w for w in fleet.status().warnings)
+
+
+def test_a_robot_that_does_not_take_the_plan_gets_it_again_then_is_planned_without(problem):
+    """An agent that reports but stays on an older revision (its subscription never matched
+    the plan's writer) would leave its jobs undone while it looks healthy."""
+    fleet = Fleet(problem, replace(SETTINGS, plan_uptake_timeout=5.0))
+    fleet.deaf.add('MARC2')
+    fleet.start()
+    fleet.tick()
+    fleet.run_solves()
+    assert fleet.state() == MissionState.EXECUTING
+    assert not kinds(fleet.tick(advance=PLAN_RESEND_AFTER - 0.3), ResendPlan)
+    effects = fleet.tick(advance=0.5)
+    assert kinds(effects, ResendPlan) == [ResendPlan(1)]
+    (warning,) = notes(effects, MissionEventKind.WARNING)
+    assert warning.robot == 'MARC2' and 'has not taken plan revision 1' in warning.reasons[0]
+    assert not kinds(fleet.tick(advance=1.0), ResendPlan)  # once per revision
+    assert not kinds(fleet.effects, Solve)[1:]
+    (request,) = kinds(fleet.tick(advance=5.0 - PLAN_RESEND_AFTER - 1.0), Solve)
+    assert "robot 'MARC2' has not taken plan revision 1 within 5 s" in request.reasons
+    assert not request.state.robots['MARC2'].healthy
+    (published,) = kinds(fleet.run_solves(), PublishPlan)
+    assert 'MARC2' not in published.result.schedule.sequences
+    # Left out until it takes a revision, however long that takes: no re-plan meanwhile.
+    assert not kinds(fleet.tick(advance=12.0), Solve)
+    assert any("'MARC2' has not taken plan revision 1" in w for w in fleet.status().warnings)
+    fleet.deaf.discard('MARC2')
+    (request,) = kinds(fleet.tick(), Solve)
+    assert "robot 'MARC2' available" in request.reasons
+
+
+def test_robots_that_take_every_plan_are_never_told_again(problem):
+    fleet = executing(problem, replace(SETTINGS, plan_uptake_timeout=3.0))
+    fleet.tick(advance=20.0)
+    assert not kinds(fleet.effects, ResendPlan)
+    assert not notes(fleet.effects, MissionEventKind.WARNING)
+    assert len(kinds(fleet.effects, Solve)) == 1
 
 
 def test_when_every_robot_refuses_the_mission_is_blocked_naming_them(problem):

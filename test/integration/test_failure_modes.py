@@ -5,7 +5,8 @@ import threading
 import time
 from pathlib import Path
 
-from fjsp_msgs.msg import MissionStatus, TaskEvent
+from fjsp_common.contract import PLAN_TOPIC, agent_node_name
+from fjsp_msgs.msg import MissionEvent, MissionStatus, TaskEvent
 from fjsp_planner.faults import FaultError, inject_fault
 
 SCENARIO = Path(__file__).resolve().parents[2] / 'config' / 'scenarios' / 'solar_panel.yaml'
@@ -104,3 +105,31 @@ def test_jobs_done_while_replanning_are_not_done_again(fjsp_fleet):
     fleet.wait_for(lambda o: o.latest_revision() >= 2, 60, 'a re-plan without MARC1')
     fleet.inject_fault('MARC1', 'recover')
     fleet.check_mission_complete(timeout=300)
+
+
+def test_an_agent_that_never_gets_the_plan_is_planned_without_until_it_does(fjsp_fleet):
+    """MARC2's agent reports, but its plan subscription hears nothing (remapped away, as a
+    subscription that never matched the plan's writer): the mission must not wait on it."""
+    fleet = fjsp_fleet(SCENARIO, time_scale=0.15, planner={'plan_uptake_timeout': 3.0})
+    for robot in ROBOTS[:3]:
+        fleet.start_agent(robot)
+    fleet.start_node(agent_node_name('MARC2'), 'robot_agents', 'robot_agent',
+                     ros_args=('-p', 'robot_name:=MARC2', '-r', f'{PLAN_TOPIC}:=plan_unheard'))
+    fleet.wait_for(lambda o: all(r in o.robots for r in ROBOTS), 60, 'every agent to report')
+    fleet.start_planner()
+    fleet.wait_for(lambda o: any(
+        e.kind == MissionEvent.KIND_WARNING and e.robot == 'MARC2'
+        and 'has not taken plan revision 1' in ' '.join(e.reasons) for e in o.mission_events),
+        30, 'a warning that MARC2 has not taken revision 1')
+    without = "robot 'MARC2' has not taken plan revision 1 within 3 s"
+    fleet.wait_for(lambda o: any(without in p.reasons for p in o.plans), 30,
+                   'a revision planned without MARC2')
+    plan = next(p for p in fleet.observer.plans if without in p.reasons)
+    assert not next(r for r in plan.robots if r.robot == 'MARC2').tasks
+    assert 'published plan revision 1 again, on a new writer' in fleet.log('planner')
+
+    fleet.stop(agent_node_name('MARC2'))
+    fleet.start_agent('MARC2')
+    fleet.wait_for(lambda o: any("robot 'MARC2' available" in p.reasons for p in o.plans), 30,
+                   'MARC2 planned in again once it follows')
+    fleet.check_mission_complete(timeout=90)

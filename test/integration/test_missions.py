@@ -8,11 +8,12 @@ from pathlib import Path
 import pytest
 import yaml
 
+from fjsp_common.contract import agent_node_name
 from fjsp_msgs.msg import MissionStatus, RobotState, TaskEvent
 from fjsp_planner.core.scenario import load_scenario
 from fjsp_planner.core.validate import validate
 from fjsp_planner.missions import MissionClient, MissionError
-from fjsp_planner.testing import executed_timeline
+from fjsp_planner.testing import Observer, executed_timeline
 
 SCENARIO = Path(__file__).resolve().parents[2] / 'config' / 'scenarios' / 'solar_panel.yaml'
 ROBOTS = ('Assembler', 'LSMS', 'MARC1', 'MARC2')
@@ -181,3 +182,26 @@ def test_planner_killed_mid_mission_resumes_it(fjsp_fleet, tmp_path):
     assert 'not starting' in fleet.log('planner')
     time.sleep(1)
     assert {p.mission_id for p in observer.plans} == {mission_id}
+
+
+def test_a_restarted_planner_publishes_its_last_plan_again(fjsp_fleet, tmp_path):
+    """Killed while publishing a plan, the planner may have reached some subscribers and not
+    others: restarted, it publishes that revision again, as it was, before re-planning."""
+    fleet = fjsp_fleet(SCENARIO, time_scale=SLOW,
+                       planner={'journal_dir': tmp_path / 'journal', 'robot_wait_timeout': 60.0})
+    fleet.start()
+    fleet.wait_for(lambda o: o.status is not None and o.status.jobs_done >= 1, 40,
+                   'the mission under way')
+    last = fleet.observer.plans[-1]
+    fleet.kill('planner')
+    for robot in ROBOTS:  # no robot to report: the restarted planner cannot re-plan yet
+        fleet.kill(agent_node_name(robot))
+    late = Observer(fleet.domain)
+    try:
+        fleet.start_planner()
+        late.wait_for(lambda o: o.plans, 30, 'a plan from the restarted planner')
+        first = late.plans[0]
+        assert (first.mission_id, first.revision, first.stamp, first.robots) == (
+            last.mission_id, last.revision, last.stamp, last.robots)
+    finally:
+        late.close()

@@ -9,7 +9,9 @@ clock); schedule time is derived from the mission start and the time scale.
 
 A robot takes part in planning only while it is *available*: it has reported, it is neither
 failed nor offline, and it follows the plans it is given (an agent that refuses a plan, e.g.
-for a robot type it cannot play, is left out and named in the warnings). The plan records, for
+for a robot type it cannot play, is left out and named in the warnings; so is one that keeps
+reporting an older revision than the latest, which it may never have received, until it
+reports the latest). The plan records, for
 each robot it counted on, the agent incarnation and failure count it saw; a robot that fails
 and recovers between two ticks, or whose agent restarts, lost its tasks even though it looks
 healthy, and is re-planned in. A robot whose heartbeat is lost is offline until it has been
@@ -50,6 +52,12 @@ overrun, publishing, the agents taking it): what they do by then is kept in it."
 RETRY_FAILED_REPLAN = 1.0
 """Seconds after which a re-plan that failed is tried again, if no new report came first."""
 
+PLAN_RESEND_AFTER = 2.0
+"""Seconds a robot that reports may stay on an older plan revision than the latest before
+the plan is published again, on a new writer: a sample lost on a matched subscription is
+resent by the reliable writer long before, so the robot's subscription is likely not matched
+to the writer at all."""
+
 STARVED = 0.25
 """Seconds between two ticks beyond which the node could not take messages for a while: the
 heartbeats it has not processed yet come first, before any robot is judged silent."""
@@ -68,6 +76,9 @@ class Settings:
     time_scale: float = 0.05
     blocked_timeout: float = 0.0
     """Seconds a mission may stay blocked before it fails; 0: it waits for the fleet."""
+    plan_uptake_timeout: float = 10.0
+    """Seconds a robot that reports may stay on an older plan revision than the latest before
+    it is planned without, until it reports the latest."""
 
 
 @dataclass(frozen=True)
@@ -171,7 +182,14 @@ class Note:
     job: the revision its completion was reported under)."""
 
 
-Effect = Solve | PublishPlan | JobDone | Note
+@dataclass(frozen=True)
+class ResendPlan:
+    """Publish the plan of `revision` again, on a new writer: a robot has not taken it."""
+
+    revision: int
+
+
+Effect = Solve | PublishPlan | JobDone | Note | ResendPlan
 
 
 @dataclass(frozen=True)
@@ -278,6 +296,14 @@ class _Mission:
     journaled: dict[str, int] = field(default_factory=dict)
     """Rebuilt after a planner restart: the agent incarnation each robot's tasks were planned
     for, as the journal has them."""
+    published_at: float | None = None
+    """Wall seconds when the latest revision was published (or, resumed, when the mission
+    was rebuilt)."""
+    resent: int = 0
+    """The latest revision published again for a robot that had not taken it."""
+    missed: dict[str, int] = field(default_factory=dict)
+    """Robot -> the revision it did not take within `plan_uptake_timeout`: it is planned
+    without until it reports the latest revision."""
 
 
 class MissionController:
@@ -368,6 +394,7 @@ class MissionController:
                 mission.journaled = dict(record.incarnations)
             elif isinstance(record, DoneRecord):
                 tracker.restore_done(record.assignment)
+        mission.published_at = wall
         self.mission = mission
         where = (f'at plan revision {tracker.revision}, {len(tracker.done)}/'
                  f'{len(tracker.jobs)} jobs done' if mission.schedule is not None
@@ -538,6 +565,8 @@ class MissionController:
                 return effects + self._plan(mission, wall)
             return effects + self._resume_when_caught_up(mission, wall)
         if mission.state in (MissionState.EXECUTING, MissionState.BLOCKED):
+            if not starved:
+                effects += self._check_uptake(mission, wall)
             reasons = self._replan_reasons(mission, wall)
             if mission.pending and (reasons or self._may_retry(mission, wall)):
                 reasons, mission.pending = list(mission.pending) + reasons, ()
@@ -583,6 +612,39 @@ class MissionController:
                     effects += self._record(self.mission, agent.report, wall)
         return effects
 
+    def _check_uptake(self, mission: _Mission, wall: float) -> list[Effect]:
+        """Robots that report, but not the latest revision: the plan is published again
+        after PLAN_RESEND_AFTER, and they are planned without after `plan_uptake_timeout`,
+        until they report it."""
+        if mission.schedule is None or mission.published_at is None:
+            return []
+        revision, effects = mission.tracker.revision, []
+        waited = wall - mission.published_at
+        for robot in mission.problem.robots:
+            agent = self.agents.get(robot.name)
+            if agent is None or agent.offline_since is not None:
+                continue
+            report = agent.report
+            if report.refusal:
+                continue  # it has the plan, and says why it does not follow it
+            if report.mission_id == mission.id and report.revision >= revision:
+                mission.missed.pop(robot.name, None)
+                continue
+            if waited < PLAN_RESEND_AFTER:
+                continue
+            told = f'uptake {robot.name} {revision}'
+            if told not in mission.warned:
+                mission.warned.add(told)
+                effects.append(Note(MissionEventKind.WARNING, (
+                    f"robot '{robot.name}' has not taken plan revision {revision} for "
+                    f'{waited:.1f} s: published again',), robot=robot.name))
+            if mission.resent < revision:
+                mission.resent = revision
+                effects.append(ResendPlan(revision))
+            if waited >= self.settings.plan_uptake_timeout:
+                mission.missed.setdefault(robot.name, revision)
+        return effects
+
     def _heard(self, robot: str) -> bool:
         agent = self.agents.get(robot)
         return agent is not None and agent.offline_since is None
@@ -603,6 +665,9 @@ class MissionController:
                 why[robot.name] = 'failed'
             elif agent.report.refusal:
                 why[robot.name] = f'refuses its plan: {agent.report.refusal}'
+            elif robot.name in mission.missed:
+                why[robot.name] = (f'has not taken plan revision {mission.missed[robot.name]} '
+                                   f'within {self.settings.plan_uptake_timeout:g} s')
             else:
                 why[robot.name] = ''
         return why
@@ -683,7 +748,7 @@ class MissionController:
         # Robots start a job as soon as its robots and predecessors are ready, so they may
         # be ahead of the plan: what they started is kept too.
         started = frozenset(name for name, record in mission.tracker.jobs.items()
-                            if record.started or record.end is not None)
+                            if record.begun)
         return Solve(self._tokens, 'improve', published.residual.problem, limit,
                      state=solving.state, reasons=solving.reasons, published=published,
                      frozen_until=self._now(mission, wall + limit + IMPROVE_REACH),
@@ -730,7 +795,7 @@ class MissionController:
                 for r in mission.problem.robots))
             mission.problem = problem
             mission.tracker.extend(problem)
-        return self._publish(mission, posed, result, frozenset(), ())
+        return self._publish(mission, posed, result, frozenset(), (), wall)
 
     def _new_revision(self, mission, solving, outcome, wall, fleet_now) -> list[Effect]:
         tracker = mission.tracker
@@ -781,7 +846,7 @@ class MissionController:
                       revision=mission.tracker.revision) for job in residual.voided]
         mission.blocked, mission.blocked_since = (), None
         published = self._publish(mission, residual.problem, result,
-                                  continued | frozenset(progressed), solving.reasons)
+                                  continued | frozenset(progressed), solving.reasons, wall)
         if result.status == Status.OPTIMAL:
             return notes + published
         return notes + published + [self._improve(mission, solving, replanned, wall)]
@@ -817,7 +882,7 @@ class MissionController:
         reason = (f'a better plan: makespan {mission.planned_makespan:.2f} -> '
                   f'{float(better.result.makespan):.2f}')
         published = self._publish(mission, better.residual.problem, better.result,
-                                  continued | frozenset(progressed), (reason,))
+                                  continued | frozenset(progressed), (reason,), wall)
         if better.result.status == Status.OPTIMAL:
             return published
         return published + [self._improve(mission, solving, better, wall,
@@ -841,7 +906,7 @@ class MissionController:
                 continue
             record = tracker.jobs[job.name]
             started_before = job.name in posed_state.running or job.name in posed_state.done
-            if (record.end is not None or record.started) and not started_before:
+            if record.begun and not started_before:
                 moved.append(job.name)
         return moved
 
@@ -864,8 +929,9 @@ class MissionController:
                 return False
         return True
 
-    def _publish(self, mission, posed, result, continued, reasons) -> list[Effect]:
+    def _publish(self, mission, posed, result, continued, reasons, wall) -> list[Effect]:
         tracker = mission.tracker
+        mission.published_at = wall
         revision = self._next_revision(mission)
         tracker.set_plan(result.schedule, revision, continued)
         mission.schedule = result.schedule

@@ -21,6 +21,7 @@ from pathlib import Path
 from diagnostic_msgs.msg import DiagnosticArray
 from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.node import Node
+from rclpy.serialization import deserialize_message, serialize_message
 from rclpy.task import Future as RosFuture
 from rclpy.time import Time
 
@@ -71,6 +72,7 @@ from fjsp_planner.core.mission import (
     MissionController,
     Note,
     PublishPlan,
+    ResendPlan,
     RobotReport,
     Settings,
     Solve,
@@ -86,7 +88,7 @@ ANSWERS_KEPT = 256
 """Answers kept per service for requests that are resent."""
 
 RUNTIME_PARAMETERS = ('time_limit', 'replan_time_limit', 'workers', 'heartbeat_timeout',
-                      'delay_threshold', 'robot_wait_timeout')
+                      'delay_threshold', 'robot_wait_timeout', 'plan_uptake_timeout')
 """Honoured when set at run time (read at each use); every other parameter is read-only."""
 
 
@@ -183,6 +185,9 @@ class PlannerNode(Node):
         declare(self, 'robot_wait_timeout', 15.0,
                 'seconds to wait for every robot to report before planning without it',
                 low=0.0, high=3600.0, read_only=False)
+        declare(self, 'plan_uptake_timeout', 10.0,
+                'seconds a reporting robot may stay on an older plan revision than the latest '
+                'before it is planned without', low=0.1, high=3600.0, read_only=False)
         self.time_scale = declare(self, 'time_scale', 0.05,
                                   'wall seconds per schedule unit', low=1e-4, high=1000.0)
         self.start_delay = declare(self, 'start_delay', 0.5,
@@ -219,6 +224,9 @@ class PlannerNode(Node):
         """Seconds from the decision to re-plan to the new revision's publication."""
         self.last_published = None
         """(mission, revision, stamp) of this node's latest plan, which it hears back."""
+        self.last_plan: Plan | None = None
+        """The latest plan message published, unsigned: published again for a robot that
+        has not taken it."""
         self.event_count = 0
         self.incarnation = self.auth.signer.incarnation
         self.solves: dict[int, Future] = {}
@@ -279,6 +287,7 @@ class PlannerNode(Node):
                         heartbeat_timeout=value['heartbeat_timeout'],
                         delay_threshold=value['delay_threshold'],
                         robot_wait_timeout=value['robot_wait_timeout'],
+                        plan_uptake_timeout=value['plan_uptake_timeout'],
                         start_delay=self.start_delay, time_scale=self.time_scale)
 
     def wall(self) -> float:
@@ -329,6 +338,7 @@ class PlannerNode(Node):
         log.warning(f"resuming mission '{head.mission_id}' from {path}")
         self.carry_out(self.controller.resume(head.mission_id, problem, settings,
                                               head.accepted, records[1:], self.wall()))
+        self.publish_journaled_plan(head.mission_id)
         # The previous process's event history died with it, and a completion it published
         # just before it was killed may never have reached anyone: declared again, with its
         # own id, so those who heard it recognise it.
@@ -337,6 +347,27 @@ class PlannerNode(Node):
                 self.publish_done_event(record.event_id, head.mission_id, record.assignment.job,
                                         record.revision, float(record.assignment.end))
         return head.origin
+
+    def publish_journaled_plan(self, mission_id: str) -> None:
+        """Publish again the plan the previous process published last: killed while
+        publishing it, it may have reached some subscribers and not others, and an agent
+        following it reports work no one else could place."""
+        path = plan_file(self.journal.path)
+        revision = self.controller.mission.tracker.revision
+        try:
+            msg = deserialize_message(path.read_bytes(), Plan)
+        except FileNotFoundError:
+            return
+        except Exception as error:  # noqa: BLE001 - any damage to the file means the same
+            self.get_logger().warning(f'cannot publish the last plan again from {path}: '
+                                      f'{error}')
+            return
+        if msg.mission_id != mission_id or msg.revision != revision:
+            return
+        self.last_published = (msg.mission_id, msg.revision, msg.stamp)
+        self.last_plan = msg
+        self.plan_pub.publish(self.auth.sign(msg, PLAN_TOPIC))
+        self.get_logger().info(f'published plan revision {msg.revision} again, as journaled')
 
     def ran_before(self, origin: str) -> bool:
         return self.journal_dir is not None and any(
@@ -645,6 +676,8 @@ class PlannerNode(Node):
                 self.solve(effect)
             elif isinstance(effect, PublishPlan):
                 self.publish_plan(effect)
+            elif isinstance(effect, ResendPlan):
+                self.resend_plan(effect)
             elif isinstance(effect, JobDone):
                 self.publish_job_done(effect)
             elif isinstance(effect, Note):
@@ -658,6 +691,7 @@ class PlannerNode(Node):
         if self.journal is not None:
             self.journal.write(EndRecord(str(state), tuple(reasons)))
             self.journal.close()
+            plan_file(self.journal.path).unlink(missing_ok=True)
             self.journal = None
         if self.goal is not None and not self.goal.ended.done():
             self.goal.ended.set_result(state)
@@ -680,6 +714,9 @@ class PlannerNode(Node):
                            mission.id, effect.revision, start, mission.settings.time_scale,
                            stamp, effect.continued, effect.reasons, effect.incarnations)
         self.last_published = (msg.mission_id, msg.revision, msg.stamp)
+        self.last_plan = msg
+        if self.journal is not None:
+            write_plan_file(plan_file(self.journal.path), msg)
         self.plan_pub.publish(self.auth.sign(msg, PLAN_TOPIC))
         log = self.get_logger()
         if effect.cancelled:
@@ -699,6 +736,18 @@ class PlannerNode(Node):
         for robot_plan in msg.robots:
             log.info(f'  {robot_plan.robot}: '
                      + (' -> '.join(t.job for t in robot_plan.tasks) or 'no task'))
+
+    def resend_plan(self, effect: ResendPlan) -> None:
+        msg = self.last_plan
+        if msg is None or msg.revision != effect.revision:
+            return
+        # A subscription that has not matched the writer in seconds may never match it; a new
+        # writer is announced to every subscription afresh.
+        self.destroy_publisher(self.plan_pub)
+        self.plan_pub = self.create_publisher(Plan, PLAN_TOPIC, LATCHED_QOS)
+        self.plan_pub.publish(self.auth.sign(msg, PLAN_TOPIC))
+        self.get_logger().warning(f'published plan revision {msg.revision} again, on a new '
+                                  'writer')
 
     def publish_job_done(self, effect: JobDone) -> None:
         mission = self.controller.mission
@@ -809,6 +858,19 @@ class PlannerNode(Node):
         if self.journal is not None:
             self.journal.close()
         return super().destroy_node()
+
+
+def plan_file(journal: Path) -> Path:
+    """Where the latest plan message of the mission journaled in `journal` is kept."""
+    return journal.with_name(journal.name + '.plan')
+
+
+def write_plan_file(path: Path, msg: Plan) -> None:
+    """`msg` in `path`, whole or not at all: a process killed while writing leaves the
+    previous one."""
+    partial = path.with_name(path.name + '.partial')
+    partial.write_bytes(serialize_message(msg))
+    partial.replace(path)
 
 
 def main(args=None):
