@@ -65,6 +65,11 @@ class JobRecord:
     def start(self) -> float | None:
         return min(self.started.values()) if self.started else None
 
+    @property
+    def begun(self) -> bool:
+        """A robot started it, or it is done."""
+        return bool(self.started) or self.end is not None
+
 
 @dataclass
 class RobotRecord:
