@@ -281,6 +281,22 @@ def test_a_robot_that_does_not_take_the_plan_gets_it_again_then_is_planned_witho
     assert "robot 'MARC2' available" in request.reasons
 
 
+def test_a_robot_back_from_an_offline_spell_has_time_to_take_the_plan(problem):
+    """Offline, it could not take the revision published meanwhile: its lag counts from
+    when it is heard again."""
+    fleet = executing(problem)
+    fleet.deaf.add('MARC2')
+    fleet.tick(advance=1.5, robots=ROBOTS[:3])
+    assert "robot 'MARC2' offline (heartbeat lost)" in kinds(fleet.effects, Solve)[-1].reasons
+    (published,) = kinds(fleet.run_solves(), PublishPlan)
+    fleet.tick(advance=PLAN_RESEND_AFTER + 1.0, robots=ROBOTS[:3])
+    effects = fleet.tick(advance=PLAN_RESEND_AFTER - 0.5)  # back, on revision 1 at first
+    assert not kinds(effects, ResendPlan) and not notes(effects, MissionEventKind.WARNING)
+    fleet.deaf.discard('MARC2')
+    fleet.tick(advance=2.0)
+    assert not kinds(fleet.effects, ResendPlan)
+
+
 def test_robots_that_take_every_plan_are_never_told_again(problem):
     fleet = executing(problem, replace(SETTINGS, plan_uptake_timeout=3.0))
     fleet.tick(advance=20.0)

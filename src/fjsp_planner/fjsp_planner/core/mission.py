@@ -224,6 +224,9 @@ class _Agent:
     offline_since: float | None = None
     back_since: float | None = None
     """First report after an offline spell: it counts again a heartbeat timeout later."""
+    reachable_since: float = 0.0
+    """Wall seconds since when its agent could have received the latest plan: its first
+    report, its first after an offline spell or a restart."""
 
 
 class _RecentEvents:
@@ -456,11 +459,13 @@ class MissionController:
         agent = self.agents.get(report.robot)
         restarted = False
         if agent is None:
-            agent = self.agents[report.robot] = _Agent(report, wall)
+            agent = self.agents[report.robot] = _Agent(report, wall, reachable_since=wall)
         else:
             if agent.offline_since is not None and agent.back_since is None:
-                agent.back_since = wall
+                agent.back_since = agent.reachable_since = wall
             restarted = report.incarnation != agent.report.incarnation
+            if restarted:
+                agent.reachable_since = wall
             agent.report, agent.heard = report, wall
         mission = self.mission
         if mission is None:
@@ -619,11 +624,11 @@ class MissionController:
         if mission.schedule is None or mission.published_at is None:
             return []
         revision, effects = mission.tracker.revision, []
-        waited = wall - mission.published_at
         for robot in mission.problem.robots:
             agent = self.agents.get(robot.name)
             if agent is None or agent.offline_since is not None:
                 continue
+            waited = wall - max(mission.published_at, agent.reachable_since)
             report = agent.report
             if report.refusal:
                 continue  # it has the plan, and says why it does not follow it
