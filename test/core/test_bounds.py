@@ -230,6 +230,35 @@ def test_load_bound_on_the_tiny_panels(two_panels_optimum):
     assert panel_load_bound(tiny(2), Fraction(23), 30) == 9 <= two_panels_optimum
 
 
+def waiting_chain(shift: int) -> Problem:
+    """Two panels `shift` apart of x -> y -> z -> w, all at one spot. x and z need both A and
+    B (1 each), only A does y (5), only B does w (6); both travel 1 per unit of distance."""
+    base = Problem(
+        operation_types={0: 'hold', 1: 'weld', 2: 'move', 3: 'locomote'},
+        robot_types={'A': {0: Fraction(1), 2: Fraction(5), 3: Fraction(1)},
+                     'B': {0: Fraction(1), 1: Fraction(6), 3: Fraction(1)}},
+        robots=(Robot('A', 'A'), Robot('B', 'B')),
+        jobs=(Job('x', 'a', ((0, 0),)), Job('y', 'a', ((2,),)), Job('z', 'a', ((0, 0),)),
+              Job('w', 'a', ((1,),))),
+        distances={}, precedence=(('x', 'y'), ('y', 'z'), ('z', 'w')), locomote=3,
+        name='waiting chain')
+    return repeat_panels(base, 2, shift)
+
+
+@pytest.mark.parametrize(('shift', 'by_hand', 'optimum'), [(1, 19, 23), (3, 25, 27),
+                                                           (10, 36, 36)])
+def test_load_bound_counts_the_wait_around_a_job_every_other_one_precedes_or_follows(
+        shift, by_hand, optimum):
+    """B works 8 per panel (x, z, w) and crosses once (`shift`). While A does y, no other job
+    of the panel can run: B, working before and after it, waits 5 there or goes to the other
+    panel and back, one crossing more. So 16 + shift + 2 * min(5, shift); the loads alone
+    give 16 + shift. The optima are proven by CP-SAT."""
+    problem = waiting_chain(shift)
+    exact = solve(problem, time_limit=20)
+    assert exact.status == Status.OPTIMAL and exact.makespan == optimum
+    assert panel_load_bound(problem, exact.makespan + 1, 20) == by_hand <= optimum
+
+
 @pytest.mark.parametrize(('panels', 'best', 'by_hand'), [(5, Fraction(283), 177),
                                                           (10, Fraction(1237, 2), 365)])
 def test_load_bound_on_the_paper(panels, best, by_hand):

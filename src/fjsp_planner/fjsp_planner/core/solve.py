@@ -35,8 +35,8 @@ MACHINE_SHARE = 0.1
 """Share of the time limit for the panel machine bound (`machine_bound`): 2 panels of the
 paper are solved to its optimum in about 3 s; beyond, it returns what it proved in time."""
 LOAD_SHARE = 0.05
-"""Share of the time limit for the panel load bound (`load_bound`): it proves its optimum on
-2 to 10 panels of the paper in 0.1-1.5 s (2 workers) and then stops."""
+"""Share of the time limit for the panel load bound (`load_bound`): it proves the loads alone
+on 2 to 10 panels of the paper in 0.1-2 s (2 workers), then counts waits for the rest."""
 MIN_PANEL_SECONDS = 0.5
 """Below this the one-panel solves' own overhead outweighs their share."""
 HANDOFF_SHARE = 0.5
