@@ -79,6 +79,40 @@ def _panel_distance(problem: Problem) -> Fraction:
     return cached
 
 
+def least_travel(problem: Problem, robot: str, a: str, b: str) -> Fraction:
+    """Least time for the robot to get from place a to place b of the first panel's jobs,
+    doing other jobs on the way or not: the distance table need not obey the triangle
+    inequality (the paper's does not: M1 to Ja is 43, through Ac 35), so the direct travel
+    is no bound on the time between two jobs of a robot that works elsewhere in between."""
+    if problem.locomote is None or a == b:
+        return Fraction(0)
+    r = problem.robot(robot)
+    return (_panel_paths(problem)[a, b] * problem.robot_types[r.type][problem.locomote]
+            / r.speed)
+
+
+def _panel_paths(problem: Problem) -> dict[tuple[str, str], Fraction]:
+    """(place, place) -> least distance between places of the first panel's jobs along job
+    places (Floyd-Warshall); a detour through another panel crosses twice, so no path costs
+    more than two least crossings. Computed once per problem."""
+    cached = problem.__dict__.get('_panel_paths')
+    if cached is None:
+        places = sorted({problem.job(j).location for j in (
+            problem.panels[0] if problem.panels else [job.name for job in problem.jobs])})
+        detour = 2 * _panel_distance(problem) if len(problem.panels) >= 2 else None
+        cached = {}
+        for a in places:
+            for b in places:
+                direct = problem.distance(a, b)
+                cached[a, b] = direct if detour is None else min(direct, detour)
+        for via in places:
+            for a in places:
+                for b in places:
+                    cached[a, b] = min(cached[a, b], cached[a, via] + cached[via, b])
+        object.__setattr__(problem, '_panel_paths', cached)
+    return cached
+
+
 def panel_limits(problem: Problem, incumbent: Fraction) -> dict[str, int]:
     """robot -> how many panels it can work in without ending after `incumbent`, for the
     robots that cannot reach every panel: visiting m panels takes m - 1 moves between panels,

@@ -5,22 +5,27 @@ Let G be the robots that can reach every panel within a known schedule's makespa
 others, "limited", reach only `bounds.panel_limits` many), and call a staffing of a job
 *heavy* when it needs more than half of G. Two heavy staffings together need more of G than
 there is, so heavy jobs run one after another, as on one machine; and a limited robot does
-one job at a time. The relaxation keeps, of every panel:
+one job at a time. The relaxation keeps every job of every panel, with:
 
-- the jobs that some staffing makes heavy or gives a limited robot, each with its staffing
-  choices (the robots, the least duration) and whether a choice is heavy;
-- its precedence chains: the least time from a job's end to a later job's start (heads,
-  tails and lags at least durations plus the travel a chain forces: a robot that every
-  staffing of a job needs leaves from that job's place);
-- between jobs of different panels that share a robot under their choices, that robot's
-  crossing from one panel to the other (the slowest of the shared robots, for the cheapest
-  pair of choices);
+- its staffing choices (the robots, the least duration), whether a choice is heavy and
+  which limited robots it takes;
+- its panel's precedence chains: the least time from a job's end to a later job's start
+  (heads, tails and lags at least durations plus the travel a chain forces: a robot that
+  every staffing of a job needs leaves from that job's place);
+- for two jobs whose choices share a robot, that the one ends before the other starts,
+  apart by the shared robot's least travel from one place to the other (the slowest of the
+  shared robots, for the cheapest pair of robot sets): a crossing between panels, the
+  shortest way between places inside one (`bounds.least_travel`);
+- for a jig job whose robots all hold into another job, that those robots start nothing
+  else between the jig job's start and the held job's end;
 
-and forgets the rest (the robots' other jobs, travel inside a panel off the chains). At least
-N - (sum of the limits) panels are done without limited robots; the others may have them all.
-Every schedule shorter than U is a schedule of this relaxation, so its least makespan, or the
-bound CP-SAT proves on it within the time given, bounds every schedule shorter than U, and
-min(bound, U) bounds all. Times are floored onto an integer grid, which only lowers it.
+and forgets the rest: which robot of a set does what, and routes (two jobs of a robot are
+kept apart by the least travel between them, not by the sum along the robot's route). At
+least N - (sum of the limits) panels are done without limited robots; the others may have
+them all. Every schedule shorter than U is a schedule of this relaxation, so its least
+makespan, or the bound CP-SAT proves on it within the time given, bounds every schedule
+shorter than U, and min(bound, U) bounds all. Times are floored onto an integer grid, which
+only lowers it.
 """
 
 import itertools
@@ -33,6 +38,7 @@ from fjsp_planner.core.bounds import (
     _staffings,
     _topological,
     crossing_cost,
+    least_travel,
     panel_limits,
 )
 from fjsp_planner.core.problem import Problem
@@ -41,15 +47,20 @@ MAX_CHOICES = 8
 """Staffing choices kept apart per job and kind of choice; beyond, they merge into one at the
 least duration that stands for all their robot sets (weaker, still a lower bound)."""
 MAX_GRID = 1000
+EVERY_JOB_LIMIT = 30
+"""Problems of at most this many jobs keep every job in the relaxation, which CP-SAT's
+default search proves on 2 panels of the paper (24 jobs) in about 2 s. On larger ones it
+proves less in the time than the relaxation of the heavy jobs and those of limited robots
+alone (3 panels in 6 s: 109 against 124, 5 panels 166 against 198), which they keep."""
 SMALL = 20
-"""Relaxations of at most this many jobs are left to CP-SAT's default search, which proves
-2 panels of the paper (18 jobs) in 2-4 s; on larger ones its bound stays near the linear
-relaxation's, and BOUND_SUBSOLVERS do better."""
+"""Relaxations of the heavy and limited jobs alone of at most this many jobs are left to
+CP-SAT's default search, which proves such a relaxation of 2 panels of the paper (18 jobs)
+in 2-4 s; on larger ones its bound stays near the linear relaxation's, and
+BOUND_SUBSOLVERS do better. Relaxations of every job are left to the default search."""
 BOUND_SUBSOLVERS = ('objective_lb_search', 'default_lp')
 """A worker that asks for relaxed schedules shorter than the proven bound and raises the
-bound when there are none, beside the default one: in 6 s on 2 workers, 3 panels 124 and 5
-panels 196 (default alone: 107 and 165; on 2 panels 85 1/2 where the default proves
-86 1/6)."""
+bound when there are none, beside the default one: in 6 s on 2 workers, 3 panels 126 1/3
+and 5 panels 177-196 from run to run (default alone: about 107 and 165)."""
 
 
 class _Choice:
@@ -63,8 +74,8 @@ class _Choice:
 def panel_machine_bound(problem: Problem, incumbent: Fraction, time_limit: float,
                         workers: int = 1) -> Fraction | None:
     """The bound of the module docstring, or None when it does not apply (fewer than two
-    panels, running jobs, no robot of G, or nothing heavy) or CP-SAT proves nothing in
-    `time_limit` seconds."""
+    panels, running jobs, no robot of G, or, above EVERY_JOB_LIMIT jobs, nothing heavy) or
+    CP-SAT proves nothing in `time_limit` seconds."""
     if len(problem.panels) < 2 or problem.fixed:
         return None
     limits = panel_limits(problem, incumbent)
@@ -72,6 +83,7 @@ def panel_machine_bound(problem: Problem, incumbent: Fraction, time_limit: float
     if not group:
         return None
     helped = min(len(problem.panels), sum(limits.values()))
+    every_job = len(problem.jobs) <= EVERY_JOB_LIMIT
     kinds = [(len(problem.panels) - helped, sorted(group)),
              (helped, sorted(r.name for r in problem.robots))]
     jobs, lags, holds, kind_of = [], {}, set(), []
@@ -81,28 +93,34 @@ def panel_machine_bound(problem: Problem, incumbent: Fraction, time_limit: float
         shape = _panel_shape(problem, allowed, group, set(limits))
         if shape is None:
             return None
-        panel_jobs, panel_lags, panel_holds = _within(shape, incumbent)
+        panel_jobs, panel_lags, panel_holds = _within(shape, incumbent, every_job)
         for _ in range(count):
             kind_of.append(kind)
             jobs += [(len(kind_of) - 1, *job) for job in panel_jobs]
         lags.update({(kind, a, b): lag for (a, b), lag in panel_lags.items()})
         holds |= {(kind, a, b) for a, b in panel_holds}
-    if not any(c.heavy for *_, choices in jobs for c in choices):
-        return None
     crossing = {r.name: crossing_cost(problem, r.name) for r in problem.robots}
-    return _solve(jobs, lags, holds, kind_of, crossing, time_limit, workers)
+    places = {name: problem.job(name).location for name in problem.panels[0]}
+    inner = {(r.name, a, b): least_travel(problem, r.name, places[a], places[b])
+             for r in problem.robots for a in places for b in places if a != b}
+    if not every_job and not any(c.heavy for *_, choices in jobs for c in choices):
+        return None
+    subsolvers = () if every_job or len(jobs) <= SMALL or workers < 2 else BOUND_SUBSOLVERS
+    return _solve(jobs, lags, holds, kind_of, crossing, inner, time_limit, workers,
+                  subsolvers)
 
 
-def _within(shape, incumbent):
+def _within(shape, incumbent, every_job):
     """The shape without the choices that make a job end at or after `incumbent` whatever
     else happens (no schedule shorter than it uses them), a job keeping at least its
-    fastest; jobs left with no heavy choice and no limited robot are dropped."""
+    fastest; unless `every_job`, jobs left with no heavy choice and no limited robot are
+    dropped."""
     jobs, lags, holds = shape
     kept = []
     for name, head, tail, choices in jobs:
         fit = [c for c in choices if head + c.duration + tail < incumbent]
         fit = fit or [min(choices, key=lambda c: c.duration)]
-        if any(c.heavy or c.limited for c in fit):
+        if every_job or any(c.heavy or c.limited for c in fit):
             kept.append((name, head, tail, fit))
     names = {job[0] for job in kept}
     return (kept, {(a, b): lag for (a, b), lag in lags.items() if a in names and b in names},
@@ -110,8 +128,8 @@ def _within(shape, incumbent):
 
 
 def _panel_shape(problem: Problem, allowed, group, limited):
-    """For one panel staffed from `allowed`: the jobs the relaxation keeps, as (name, head,
-    tail, choices), and the lags between them, or None if some job cannot be staffed."""
+    """For one panel staffed from `allowed`: its jobs as (name, head, tail, choices), the lags
+    between them and the holding pairs, or None if some job cannot be staffed."""
     durations, choices, staffed = {}, {}, {}
     for name in problem.panels[0]:
         fastest = {}
@@ -124,9 +142,7 @@ def _panel_shape(problem: Problem, allowed, group, limited):
             return None
         durations[name] = min(fastest.values())
         staffed[name] = list(fastest)
-        kept = _choices(fastest, group, limited)
-        if any(c.heavy or c.limited for c in kept):
-            choices[name] = kept
+        choices[name] = _choices(fastest, group, limited)
     names = set(problem.panels[0])
     inside = [(a, b) for a, b in problem.precedence if a in names and b in names]
     inside += [(a, b) for a, b, _ in problem.holding if a in names and b in names]
@@ -138,7 +154,7 @@ def _panel_shape(problem: Problem, allowed, group, limited):
 
     def moved(a, b):
         here, there = problem.job(a).location, problem.job(b).location
-        return min(max((problem.travel(r, here, there) for r in robots & always[a]),
+        return min(max((least_travel(problem, r, here, there) for r in robots & always[a]),
                        default=Fraction(0)) for robots in staffed[b])
 
     arcs = {(a, b): moved(a, b) for a, b in inside}
@@ -166,7 +182,7 @@ def _panel_shape(problem: Problem, allowed, group, limited):
     sources = [a for a, _, _ in problem.holding]
     targets = {b for _, b, _ in problem.holding}
     holds = {(a, b) for a, b, q in problem.holding
-             if a in choices and b in choices and sources.count(a) == 1 and b not in sources
+             if a in names and b in names and sources.count(a) == 1 and b not in sources
              and a not in targets and all(set(plan) == {q} for plan in problem.job(a).plans)}
     jobs = [(name, heads[name], tails[name], found) for name, found in choices.items()]
     return jobs, lags, holds
@@ -192,11 +208,30 @@ def _choices(fastest, group, limited) -> list[_Choice]:
     return out
 
 
-def _solve(jobs, lags, holds, kind_of, crossing, time_limit, workers) -> Fraction | None:
+def _solve(jobs, lags, holds, kind_of, crossing, inner, time_limit, workers, subsolvers
+           ) -> Fraction | None:
     """CP-SAT on the relaxation: `jobs` (panel, name, head, tail, choices), `lags` (kind,
     name, later name) -> least time between them inside a panel, `holds` (kind, jig job,
-    held job) whose robots are busy from the one's start to the other's end."""
+    held job) whose robots are busy from the one's start to the other's end, `crossing`
+    robot -> least move between panels, `inner` (robot, name, name) -> least move between
+    two jobs of a panel; `subsolvers` join CP-SAT's default ones."""
     keys = [(panel, name) for panel, name, *_ in jobs]
+    index = {key: k for k, key in enumerate(keys)}
+    held = {index[panel, a]: index[panel, b] for panel, kind in enumerate(kind_of)
+            for held_kind, a, b in holds if held_kind == kind}
+
+    def gap(a, b, robots):
+        """Least time from job a's end to job b's start for all of `robots` to get there."""
+        if keys[a][0] != keys[b][0]:
+            return max(crossing[r] for r in robots)
+        return max(inner[r, keys[a][1], keys[b][1]] for r in robots)
+
+    def least_gap(a, first, b, second):
+        """The least gap for the robots a choice of a's shares with one of b's, or None
+        when some pair of their robot sets shares none (the two may overlap)."""
+        shared = [x & y for x in first.sets for y in second.sets]
+        return min(gap(a, b, s) for s in shared) if all(shared) else None
+
     lag = {}
     for a, b in itertools.permutations(range(len(jobs)), 2):
         if keys[a][0] == keys[b][0]:
@@ -207,14 +242,21 @@ def _solve(jobs, lags, holds, kind_of, crossing, time_limit, workers) -> Fractio
     """(a, i, b, j) -> least time between a's end and b's start when a comes first with
     choice i and b with choice j and the two cannot overlap; absent when they can."""
     for a, b in itertools.permutations(range(len(jobs)), 2):
-        other_panel = keys[a][0] != keys[b][0]
         for i, first in enumerate(jobs[a][4]):
             for j, second in enumerate(jobs[b][4]):
-                # Two heavy staffings always share a robot of G.
-                shared = [x & y for x in first.sets for y in second.sets]
-                if all(shared):
-                    moves[a, i, b, j] = min(max(crossing[r] for r in s) for s in shared) if (
-                        other_panel) else Fraction(0)
+                found = least_gap(a, first, b, second)
+                if found is not None:
+                    moves[a, i, b, j] = found
+    after_hold = {}
+    """(a, i, b, j) -> least time between the end of the job a holds into and b's start,
+    when b comes after a with choice j and shares a robot with a's choice i: a's robots
+    hold on into that job before they can go."""
+    for a, b in ((a, b) for a in held for b in range(len(jobs)) if b not in (a, held[a])):
+        for i, first in enumerate(jobs[a][4]):
+            for j, second in enumerate(jobs[b][4]):
+                found = least_gap(held[a], first, b, second)
+                if found is not None:
+                    after_hold[a, i, b, j] = found
     values = [v for job in jobs for v in (job[2], job[3], *(c.duration for c in job[4]))]
     values += list(lag.values()) + list(moves.values())
     scale = min(MAX_GRID, math.lcm(*(v.denominator for v in values)))
@@ -249,6 +291,21 @@ def _solve(jobs, lags, holds, kind_of, crossing, time_limit, workers) -> Fractio
         m.add(makespan >= end[k] + ticks(job[3]))
     for (a, b), found in lag.items():
         m.add(start[b] >= end[a] + ticks(found))
+
+    def after(a, i, b, j, *when):
+        """b, with choice j, after a with choice i; `when` literals enforce it."""
+        both = (picks[a][i], picks[b][j])
+        found = moves.get((a, i, b, j))
+        if found is not None:
+            m.add(start[b] >= end[a] + ticks(found)).only_enforce_if(*when, *both)
+        found = after_hold.get((a, i, b, j))
+        if found is not None:
+            m.add(start[b] >= end[held[a]] + ticks(found)).only_enforce_if(*when, *both)
+
+    for a, b in itertools.permutations(range(len(jobs)), 2):
+        if (a, b) in lag:
+            for i, j in itertools.product(range(len(jobs[a][4])), range(len(jobs[b][4]))):
+                after(a, i, b, j)
     for a, b in itertools.combinations(range(len(jobs)), 2):
         if (a, b) in lag or (b, a) in lag:
             continue
@@ -258,9 +315,8 @@ def _solve(jobs, lags, holds, kind_of, crossing, time_limit, workers) -> Fractio
             continue
         before = m.new_bool_var('')
         for i, j in pairs:
-            both = (picks[a][i], picks[b][j])
-            m.add(start[b] >= end[a] + ticks(moves[a, i, b, j])).only_enforce_if(before, *both)
-            m.add(start[a] >= end[b] + ticks(moves[b, j, a, i])).only_enforce_if(~before, *both)
+            after(a, i, b, j, before)
+            after(b, j, a, i, ~before)
     _path_cut(m, jobs, keys, lag, moves, start, end, makespan, ticks)
     firsts = {}
     for k, (panel, *_) in enumerate(jobs):
@@ -273,8 +329,7 @@ def _solve(jobs, lags, holds, kind_of, crossing, time_limit, workers) -> Fractio
     solver.parameters.max_time_in_seconds = max(0.01, time_limit)
     solver.parameters.num_workers = workers
     solver.parameters.catch_sigint_signal = False
-    if workers >= 2 and len(jobs) > SMALL:
-        solver.parameters.subsolvers.extend(BOUND_SUBSOLVERS)
+    solver.parameters.subsolvers.extend(subsolvers)
     status = solver.solve(m).name
     if status in ('INFEASIBLE', 'MODEL_INVALID') or not math.isfinite(
             solver.best_objective_bound):
