@@ -206,6 +206,20 @@ def test_a_robot_that_never_reports_is_planned_without_and_named(problem):
     assert replans and "robot 'MARC2' available" in replans[0].reasons
 
 
+def test_a_changed_robot_wait_applies_to_the_mission_waiting(problem):
+    """`robot_wait_timeout` may be set at run time (`ros2 param set`) as
+    `plan_uptake_timeout` and `heartbeat_timeout` may: a user lengthening it while a mission
+    waits for a robot expects that mission to wait longer, not only the next one."""
+    fleet = Fleet(problem)
+    fleet.start()
+    fleet.controller.settings = replace(SETTINGS, robot_wait_timeout=10.0)
+    fleet.tick(advance=5.0, robots=ROBOTS[:3])
+    assert not kinds(fleet.effects, Solve)
+    fleet.tick(advance=5.5, robots=ROBOTS[:3])
+    (request,) = kinds(fleet.effects, Solve)
+    assert {r.name for r in request.problem.robots} == {'Assembler', 'LSMS', 'MARC1'}
+
+
 def test_failure_replans_without_the_robot(problem):
     fleet = executing(problem)
     fleet.wall += 5

@@ -65,7 +65,11 @@ heartbeats it has not processed yet come first, before any robot is judged silen
 
 @dataclass(frozen=True)
 class Settings:
-    """How the planner runs missions; the node refreshes them when its parameters change."""
+    """How the planner runs missions; the node refreshes them when its parameters change.
+
+    A mission keeps the time limits, start delay, time scale and blocked timeout it started
+    with (a goal may set them); the heartbeat, delay, robot wait and plan uptake thresholds
+    are always the controller's current ones, so a change applies to the running mission."""
 
     time_limit: float = 10.0
     replan_time_limit: float = 1.0
@@ -416,7 +420,7 @@ class MissionController:
             return self._plan(mission, wall)
         waited = wall - mission.accepted
         behind = [r.name for r in mission.problem.robots if not self._caught_up(r.name)]
-        if behind and waited < mission.settings.robot_wait_timeout:
+        if behind and waited < self.settings.robot_wait_timeout:
             return []
         mission.resumed = False
         effects = self._restarted_while_down(mission, wall)
@@ -564,7 +568,7 @@ class MissionController:
             waited = wall - mission.accepted
             heard = all(self._heard(r.name) for r in mission.problem.robots)
             unmatched = subscribers is not None and subscribers < len(mission.problem.robots)
-            if (not heard or unmatched) and waited < mission.settings.robot_wait_timeout:
+            if (not heard or unmatched) and waited < self.settings.robot_wait_timeout:
                 return effects
             if not mission.resumed:
                 return effects + self._plan(mission, wall)
@@ -975,7 +979,7 @@ class MissionController:
         if mission.state == MissionState.EXECUTING:
             tracker = mission.tracker
             reasons += [f"job '{j}' aborted" for j in sorted(tracker.aborted)]
-            reasons += tracker.overruns(mission.settings.delay_threshold)
+            reasons += tracker.overruns(self.settings.delay_threshold)
         return reasons
 
     # --- ends ------------------------------------------------------------------------------
