@@ -79,36 +79,56 @@ def _panel_distance(problem: Problem) -> Fraction:
     return cached
 
 
-def least_travel(problem: Problem, robot: str, a: str, b: str) -> Fraction:
-    """Least time for the robot to get from place a to place b of the first panel's jobs,
-    doing other jobs on the way or not: the distance table need not obey the triangle
-    inequality (the paper's does not: M1 to Ja is 43, through Ac 35), so the direct travel
-    is no bound on the time between two jobs of a robot that works elsewhere in between."""
-    if problem.locomote is None or a == b:
+def least_travel(problem: Problem, robot: str, a: str, b: str, across: bool = False
+                 ) -> Fraction:
+    """Least time for the robot from job a's place to job b's place, naming the jobs by
+    their copies in the first panel: both in one panel, or `across`, a in one panel and b in
+    another. Whatever it does in between: the distance table need not obey the triangle
+    inequality (the paper's does not: `M1` to `Ja` is 43, through `Ac` 35), so the direct
+    travel is no bound on the time between two jobs of a robot that works elsewhere in
+    between (`_panel_paths`)."""
+    if problem.locomote is None or (a == b and not across):
         return Fraction(0)
     r = problem.robot(robot)
-    return (_panel_paths(problem)[a, b] * problem.robot_types[r.type][problem.locomote]
-            / r.speed)
+    return (_panel_paths(problem)[across][a, b]
+            * problem.robot_types[r.type][problem.locomote] / r.speed)
 
 
-def _panel_paths(problem: Problem) -> dict[tuple[str, str], Fraction]:
-    """(place, place) -> least distance between places of the first panel's jobs along job
-    places (Floyd-Warshall); a detour through another panel crosses twice, so no path costs
-    more than two least crossings. Computed once per problem."""
+def _panel_paths(problem: Problem) -> dict[bool, dict[tuple[str, str], Fraction]]:
+    """{False: inside, True: across}, each (job, job) of the first panel -> a least distance
+    along job places, computed once per problem (at least two panels).
+
+    A path from one place to another either stays in a panel or crosses at least once, and
+    one that leaves a panel and comes back crosses twice, each at least the least distance D
+    between two panels: so inside one panel, the shortest path (Floyd-Warshall, over its job
+    places, each step at most 2 D), the least over panels. From a panel to another: a way
+    inside the first to its last place x there, a single step to the first place z in the
+    second (at least the least distance from a copy of x to a copy of z in another panel)
+    or two crossings, then a way inside the second."""
     cached = problem.__dict__.get('_panel_paths')
     if cached is None:
-        places = sorted({problem.job(j).location for j in (
-            problem.panels[0] if problem.panels else [job.name for job in problem.jobs])})
-        detour = 2 * _panel_distance(problem) if len(problem.panels) >= 2 else None
-        cached = {}
-        for a in places:
-            for b in places:
-                direct = problem.distance(a, b)
-                cached[a, b] = direct if detour is None else min(direct, detour)
-        for via in places:
-            for a in places:
-                for b in places:
-                    cached[a, b] = min(cached[a, b], cached[a, via] + cached[via, b])
+        names = problem.panels[0]
+        copies = [[problem.job(name).location for name in panel] for panel in problem.panels]
+        detour = 2 * _panel_distance(problem)
+        indices = range(len(names))
+        inside = {}
+        for places in copies:
+            paths = {(i, j): min(problem.distance(places[i], places[j]), detour)
+                     for i in indices for j in indices}
+            for via in indices:
+                for i in indices:
+                    for j in indices:
+                        paths[i, j] = min(paths[i, j], paths[i, via] + paths[via, j])
+            inside = {key: min(found, inside.get(key, found)) for key, found in paths.items()}
+        step = {(i, j): min(min(problem.distance(first[i], second[j])
+                                for k, first in enumerate(copies)
+                                for m, second in enumerate(copies) if k != m), detour)
+                for i in indices for j in indices}
+        across = {(i, j): min(inside[i, x] + step[x, z] + inside[z, j]
+                              for x in indices for z in indices)
+                  for i in indices for j in indices}
+        cached = {False: {(names[i], names[j]): found for (i, j), found in inside.items()},
+                  True: {(names[i], names[j]): found for (i, j), found in across.items()}}
         object.__setattr__(problem, '_panel_paths', cached)
     return cached
 

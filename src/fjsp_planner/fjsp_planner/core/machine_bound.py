@@ -13,9 +13,10 @@ one job at a time. The relaxation keeps every job of every panel, with:
   (heads, tails and lags at least durations plus the travel a chain forces: a robot that
   every staffing of a job needs leaves from that job's place);
 - for two jobs whose choices share a robot, that the one ends before the other starts,
-  apart by the shared robot's least travel from one place to the other (the slowest of the
-  shared robots, for the cheapest pair of robot sets): a crossing between panels, the
-  shortest way between places inside one (`bounds.least_travel`);
+  apart by the shared robot's least travel from the one's place to the other's, in one
+  panel or from one panel to another, whatever the robot does in between
+  (`bounds.least_travel`; the slowest of the shared robots, for the cheapest pair of robot
+  sets);
 - for a jig job whose robots all hold into another job, that those robots start nothing
   else between the jig job's start and the held job's end;
 
@@ -37,7 +38,6 @@ from ortools.sat.python import cp_model
 from fjsp_planner.core.bounds import (
     _staffings,
     _topological,
-    crossing_cost,
     least_travel,
     panel_limits,
 )
@@ -47,6 +47,10 @@ MAX_CHOICES = 8
 """Staffing choices kept apart per job and kind of choice; beyond, they merge into one at the
 least duration that stands for all their robot sets (weaker, still a lower bound)."""
 MAX_GRID = 1000
+MAX_JOBS = 150
+"""Problems of more jobs get no panel machine bound: building the relaxation alone takes
+longer than its share of a usual limit (50 panels of the paper, 600 jobs: 20-40 s), and
+from 3 panels on the panel load bound proves more in the time."""
 EVERY_JOB_LIMIT = 30
 """Problems of at most this many jobs keep every job in the relaxation, which CP-SAT's
 default search proves on 2 panels of the paper (24 jobs) in about 2 s. On larger ones it
@@ -74,9 +78,9 @@ class _Choice:
 def panel_machine_bound(problem: Problem, incumbent: Fraction, time_limit: float,
                         workers: int = 1) -> Fraction | None:
     """The bound of the module docstring, or None when it does not apply (fewer than two
-    panels, running jobs, no robot of G, or, above EVERY_JOB_LIMIT jobs, nothing heavy) or
-    CP-SAT proves nothing in `time_limit` seconds."""
-    if len(problem.panels) < 2 or problem.fixed:
+    panels, running jobs, more than MAX_JOBS jobs, no robot of G, or, above EVERY_JOB_LIMIT
+    jobs, nothing heavy) or CP-SAT proves nothing in `time_limit` seconds."""
+    if len(problem.panels) < 2 or problem.fixed or len(problem.jobs) > MAX_JOBS:
         return None
     limits = panel_limits(problem, incumbent)
     group = frozenset(r.name for r in problem.robots if r.name not in limits)
@@ -99,15 +103,13 @@ def panel_machine_bound(problem: Problem, incumbent: Fraction, time_limit: float
             jobs += [(len(kind_of) - 1, *job) for job in panel_jobs]
         lags.update({(kind, a, b): lag for (a, b), lag in panel_lags.items()})
         holds |= {(kind, a, b) for a, b in panel_holds}
-    crossing = {r.name: crossing_cost(problem, r.name) for r in problem.robots}
-    places = {name: problem.job(name).location for name in problem.panels[0]}
-    inner = {(r.name, a, b): least_travel(problem, r.name, places[a], places[b])
-             for r in problem.robots for a in places for b in places if a != b}
     if not every_job and not any(c.heavy for *_, choices in jobs for c in choices):
         return None
     subsolvers = () if every_job or len(jobs) <= SMALL or workers < 2 else BOUND_SUBSOLVERS
-    return _solve(jobs, lags, holds, kind_of, crossing, inner, time_limit, workers,
-                  subsolvers)
+    names = problem.panels[0]
+    travel = {(r.name, a, b, across): least_travel(problem, r.name, a, b, across)
+              for r in problem.robots for a in names for b in names for across in (False, True)}
+    return _solve(jobs, lags, holds, kind_of, travel, time_limit, workers, subsolvers)
 
 
 def _within(shape, incumbent, every_job):
@@ -153,8 +155,7 @@ def _panel_shape(problem: Problem, allowed, group, limited):
     always = {name: frozenset.intersection(*sets) for name, sets in staffed.items()}
 
     def moved(a, b):
-        here, there = problem.job(a).location, problem.job(b).location
-        return min(max((least_travel(problem, r, here, there) for r in robots & always[a]),
+        return min(max((least_travel(problem, r, a, b) for r in robots & always[a]),
                        default=Fraction(0)) for robots in staffed[b])
 
     arcs = {(a, b): moved(a, b) for a, b in inside}
@@ -208,13 +209,13 @@ def _choices(fastest, group, limited) -> list[_Choice]:
     return out
 
 
-def _solve(jobs, lags, holds, kind_of, crossing, inner, time_limit, workers, subsolvers
+def _solve(jobs, lags, holds, kind_of, travel, time_limit, workers, subsolvers
            ) -> Fraction | None:
     """CP-SAT on the relaxation: `jobs` (panel, name, head, tail, choices), `lags` (kind,
     name, later name) -> least time between them inside a panel, `holds` (kind, jig job,
-    held job) whose robots are busy from the one's start to the other's end, `crossing`
-    robot -> least move between panels, `inner` (robot, name, name) -> least move between
-    two jobs of a panel; `subsolvers` join CP-SAT's default ones."""
+    held job) whose robots are busy from the one's start to the other's end, `travel`
+    (robot, name, name, in different panels) -> its least travel from the one job to the
+    other; `subsolvers` join CP-SAT's default ones."""
     keys = [(panel, name) for panel, name, *_ in jobs]
     index = {key: k for k, key in enumerate(keys)}
     held = {index[panel, a]: index[panel, b] for panel, kind in enumerate(kind_of)
@@ -222,9 +223,8 @@ def _solve(jobs, lags, holds, kind_of, crossing, inner, time_limit, workers, sub
 
     def gap(a, b, robots):
         """Least time from job a's end to job b's start for all of `robots` to get there."""
-        if keys[a][0] != keys[b][0]:
-            return max(crossing[r] for r in robots)
-        return max(inner[r, keys[a][1], keys[b][1]] for r in robots)
+        across = keys[a][0] != keys[b][0]
+        return max(travel[r, keys[a][1], keys[b][1], across] for r in robots)
 
     def least_gap(a, first, b, second):
         """The least gap for the robots a choice of a's shares with one of b's, or None
