@@ -166,6 +166,17 @@ def test_solve_reports_panel_bounds_on_two_panels():
     assert any('panel decomposition' in note for note in result.notes), result.notes
 
 
+def test_solve_reports_panel_bounds_when_the_search_finds_nothing():
+    """On 50 panels of the paper building the CP-SAT model takes most of a 10 s limit and the
+    search finds no schedule on this machine kind: the greedy schedule is returned, and the
+    decomposition bounds with it (it reported the critical path, 9)."""
+    problem = load_scenario(PAPER, panels=50)
+    result = solve(problem, time_limit=10)
+    assert validate(problem, result.schedule) == []
+    clique = bounds.panel_clique_bound(problem, result.makespan)
+    assert clique is not None and clique <= result.lower_bound <= result.makespan
+
+
 def random_panel(seed: int) -> Problem:
     """One panel of three jobs at two places for a slow crosser S (200 per unit of
     distance) and two arms, plans of one to three operations, a precedence chain with gaps,

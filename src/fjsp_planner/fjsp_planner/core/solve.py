@@ -122,12 +122,14 @@ def solve(problem: Problem, solver: str = 'cpsat', time_limit: float = 10.0, wor
         # The start is the shorter of the (valid) hint and the greedy schedule.
         elapsed = time.monotonic() - began
         which = 'greedy schedule' if start is greedy else 'starting schedule'
-        return Result(Status.FEASIBLE, start.makespan, critical_path_bound(problem), elapsed,
-                      start, 'greedy' if start is greedy else 'hint',
-                      first_solution_seconds=setup, best_solution_seconds=setup,
-                      notes=notes + result.notes + (f'{result.solver} found no schedule in '
-                                                    f'{time_limit:g} s; {which} returned',))
-    result = _count_from(problem, dataclasses.replace(result, notes=notes + result.notes), setup)
+        result = Result(Status.FEASIBLE, start.makespan, critical_path_bound(problem), elapsed,
+                        start, 'greedy' if start is greedy else 'hint',
+                        first_solution_seconds=setup, best_solution_seconds=setup,
+                        notes=notes + result.notes + (f'{result.solver} found no schedule in '
+                                                      f'{time_limit:g} s; {which} returned',))
+    else:
+        result = _count_from(problem, dataclasses.replace(result, notes=notes + result.notes),
+                             setup)
     if result.schedule is not None and len(problem.panels) >= 2 and not problem.fixed:
         result = _with_panel_bounds(problem, result, panel_bound)
     return result
