@@ -438,6 +438,61 @@ def test_jobs_done_while_replanning_are_not_redone(problem):
         assert f"robot '{out}' failed" in again.reasons
 
 
+def test_a_job_its_robots_reached_goes_on_when_the_new_plan_keeps_it(problem):
+    """A re-plan published while the robots of a job start it, their reports still on the
+    way: the job goes on under the new revision, so those reports count, rather than being
+    voided and the job done twice."""
+    from fjsp_planner.core.extension import extend
+
+    fleet = executing(problem)
+    first = fleet.controller.mission.schedule
+    job, assignment = min(((name, a) for name, a in first.jobs.items() if len(a.robots) > 1),
+                          key=lambda kv: kv[1].start)
+    fleet.wall += float(assignment.start)
+    fleet.execute(until=assignment.start)
+    for robot in assignment.robots:
+        fleet.event(EventKind.ARRIVED, robot, job, float(assignment.start))
+    tracker = fleet.controller.mission.tracker
+    extended, added = extend(problem, 'jobs: [{name: Inspect, location: Ad, plans: '
+                             '[[locomote]]}]\nprecedence: [[Ad, Inspect]]\n',
+                             tracker.done | tracker.running)
+    (request,) = kinds(fleet.controller.add_jobs(extended, added, fleet.wall), Solve)
+    (published,) = kinds(fleet.run_solves([request]), PublishPlan)
+    kept = published.result.schedule.jobs[job]
+    assert (kept.plan, dict(kept.robots)) == (assignment.plan, dict(assignment.robots))
+    assert all(published.result.schedule.sequences[r][0] == job for r in assignment.robots)
+    assert job in published.continued
+    assert published.revision == 2
+    for robot in assignment.robots:
+        _, ignored = fleet.event(EventKind.STARTED, robot, job, float(assignment.start),
+                                 revision=1)
+        assert ignored == ''
+    assert set(tracker.jobs[job].started) == set(assignment.robots)
+    fleet.execute()
+    assert fleet.state() == MissionState.COMPLETE
+
+
+def test_a_job_the_new_plan_gives_other_robots_starts_afresh(problem):
+    """Going on is for jobs the new plan leaves as they were: one that a failed robot was
+    waiting at is started afresh, its arrivals void."""
+    fleet = executing(problem)
+    first = fleet.controller.mission.schedule
+    job, assignment = min(((name, a) for name, a in first.jobs.items() if len(a.robots) > 1),
+                          key=lambda kv: kv[1].start)
+    fleet.wall += float(assignment.start)
+    fleet.execute(until=assignment.start)
+    for robot in assignment.robots:
+        fleet.event(EventKind.ARRIVED, robot, job, float(assignment.start))
+    out = next(r for r in assignment.robots if r != 'Assembler')
+    fleet.failures[out] += 1
+    fleet.report(out, RobotMode.FAILED)
+    (request,) = kinds(fleet.tick(), Solve)
+    (published,) = kinds(fleet.run_solves([request]), PublishPlan)
+    assert out not in published.result.schedule.jobs[job].robots
+    assert job not in published.continued
+    assert fleet.controller.mission.tracker.jobs[job].arrived == {}
+
+
 def test_stale_solve_outcomes_are_dropped(problem):
     fleet = executing(problem)
     assert fleet.controller.solved(999, None, fleet.wall) == []

@@ -854,8 +854,10 @@ class MissionController:
         notes = [Note(MissionEventKind.JOB_VOIDED, ('its hold was lost',), job=job,
                       revision=mission.tracker.revision) for job in residual.voided]
         mission.blocked, mission.blocked_since = (), None
-        published = self._publish(mission, residual.problem, result,
-                                  continued | frozenset(progressed), solving.reasons, wall)
+        continued |= frozenset(progressed)
+        continued |= self._unchanged(mission, result.schedule, continued)
+        published = self._publish(mission, residual.problem, result, continued,
+                                  solving.reasons, wall)
         if result.status == Status.OPTIMAL:
             return notes + published
         return notes + published + [self._improve(mission, solving, replanned, wall)]
@@ -890,8 +892,10 @@ class MissionController:
             return [dropped] + self._search_longer(mission, solving, solving.published, wall)
         reason = (f'a better plan: makespan {mission.planned_makespan:.2f} -> '
                   f'{float(better.result.makespan):.2f}')
-        published = self._publish(mission, better.residual.problem, better.result,
-                                  continued | frozenset(progressed), (reason,), wall)
+        continued |= frozenset(progressed)
+        continued |= self._unchanged(mission, better.schedule, continued)
+        published = self._publish(mission, better.residual.problem, better.result, continued,
+                                  (reason,), wall)
         if better.result.status == Status.OPTIMAL:
             return published
         return published + [self._improve(mission, solving, better, wall,
@@ -937,6 +941,43 @@ class MissionController:
             if fresh[:len(mine)] != mine:
                 return False
         return True
+
+    def _unchanged(self, mission, schedule: Schedule, continued) -> frozenset[str]:
+        """Jobs not begun that the new plan leaves as the old one had them: the same plan and
+        robots, and for each of those robots next in both the old and the new order, after
+        what goes on. They go on rather than start afresh: a robot may have arrived at one,
+        or started it, on reports still on their way to the planner, and starting it afresh
+        would void those arrivals and have its robots do it twice."""
+        tracker = mission.tracker
+        old = tracker.plan
+
+        def open_job(job: str) -> bool:
+            return job not in continued and not tracker.jobs[job].begun
+
+        def same(job: str) -> bool:
+            was, new = old.jobs.get(job), schedule.jobs.get(job)
+            return (was is not None and new is not None and not tracker.jobs[job].aborted
+                    and new.plan == was.plan and dict(new.robots) == dict(was.robots))
+
+        heads = {}
+        for robot, sequence in schedule.sequences.items():
+            before = [job for job in old.sequences.get(robot, ()) if open_job(job)]
+            after = [job for job in sequence if open_job(job)]
+            head = []
+            for a, b in zip(before, after, strict=False):
+                if a != b or not same(a):
+                    break
+                head.append(a)
+            heads[robot] = head
+        while True:
+            kept = {job for head in heads.values() for job in head
+                    if all(job in heads.get(r, ()) for r in schedule.jobs[job].robots)}
+            cut = {robot: head[:next((i for i, job in enumerate(head) if job not in kept),
+                                     len(head))]
+                   for robot, head in heads.items()}
+            if cut == heads:
+                return frozenset(kept)
+            heads = cut
 
     def _publish(self, mission, posed, result, continued, reasons, wall) -> list[Effect]:
         tracker = mission.tracker
