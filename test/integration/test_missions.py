@@ -11,9 +11,8 @@ import yaml
 from fjsp_common.contract import agent_node_name
 from fjsp_msgs.msg import MissionStatus, RobotState, TaskEvent
 from fjsp_planner.core.scenario import load_scenario
-from fjsp_planner.core.validate import validate
 from fjsp_planner.missions import MissionClient, MissionError
-from fjsp_planner.testing import Observer, executed_timeline
+from fjsp_planner.testing import Observer, executed_timeline, validate_executed
 
 SCENARIO = Path(__file__).resolve().parents[2] / 'config' / 'scenarios' / 'solar_panel.yaml'
 ROBOTS = ('Assembler', 'LSMS', 'MARC1', 'MARC2')
@@ -62,7 +61,7 @@ def check_done_once(problem, observer, mission_id):
     assert set(starts.values()) == {1}, starts
     executed = executed_timeline(problem, plans, events)
     assert sorted(executed.jobs) == sorted(j.name for j in problem.jobs)
-    assert validate(problem, executed) == []
+    assert validate_executed(problem, executed) == []
 
 
 def fleet_is_idle(observer):

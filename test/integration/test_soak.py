@@ -24,7 +24,6 @@ import pytest
 
 from fjsp_msgs.msg import MissionStatus, RobotState, TaskEvent
 from fjsp_planner.core.scenario import load_scenario
-from fjsp_planner.core.validate import validate
 from fjsp_planner.faults import FaultError
 from fjsp_planner.missions import MissionClient, MissionError
 from fjsp_planner.testing import (
@@ -32,6 +31,7 @@ from fjsp_planner.testing import (
     executed_timeline,
     operations_reported,
     valid_events,
+    validate_executed,
 )
 from robot_agents.agent_node import agent_node_name
 
@@ -346,7 +346,7 @@ def check_execution(problem, plans, events, complete: bool) -> list[str]:
         precedence=tuple((a, b) for a, b in problem.precedence if a in kept and b in kept),
         holding=tuple((a, b, q) for a, b, q in problem.holding if a in kept and b in kept),
         panels=())
-    problems += [f'executed timeline: {p}' for p in validate(part, executed)]
+    problems += [f'executed timeline: {p}' for p in validate_executed(part, executed)]
     # The robots of a job start it at one instant, computed alike from the same reports.
     starts = {}
     for e in last:

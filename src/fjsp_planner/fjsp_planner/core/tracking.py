@@ -521,28 +521,32 @@ class MissionTracker:
                                 for q, t in times.items()}
                          for name, times in p.robot_types.items()},
             time_overrides=dict.fromkeys(p.time_overrides, Fraction(0)),
-            distances=self._relaxed_distances(executed), fixed={}, panels=(),
+            distances=relaxed_distances(p, executed), fixed={}, panels=(),
             name=f'{p.name} as executed')
 
-    def _relaxed_distances(self, executed: Schedule) -> dict:
-        p = self.problem
-        legs = set()
-        for robot in p.robots:
-            jobs = [executed.jobs[j] for j in executed.sequences.get(robot.name, ())]
-            where = robot.start_location
-            free = robot.release_time
-            for a in jobs:
-                here = p.job(a.job).location
-                if where is not None and a.start < free + p.travel(robot.name, where, here):
-                    legs.add((where, here))
-                where, free = here, a.end
-        distances = dict(p.distances)
-        nearest = {}
-        for a, b in legs:
-            if a not in nearest:
-                nearest[a] = _shortest_distances(p, a)
-            distances[a, b] = distances[b, a] = nearest[a][b]
-        return distances
+
+def relaxed_distances(problem: Problem, executed: Schedule) -> dict:
+    """The problem's distances, with the shortest route in place of the direct one between
+    two consecutive jobs of a robot that it went between faster than directly: on its way it
+    may have passed through the location of a job that was aborted or left out of a new
+    revision (a robot withdrawn from a job waits at its location)."""
+    legs = set()
+    for robot in problem.robots:
+        jobs = [executed.jobs[j] for j in executed.sequences.get(robot.name, ())]
+        where = robot.start_location
+        free = robot.release_time
+        for a in jobs:
+            here = problem.job(a.job).location
+            if where is not None and a.start < free + problem.travel(robot.name, where, here):
+                legs.add((where, here))
+            where, free = here, a.end
+    distances = dict(problem.distances)
+    nearest = {}
+    for a, b in legs:
+        if a not in nearest:
+            nearest[a] = _shortest_distances(problem, a)
+        distances[a, b] = distances[b, a] = nearest[a][b]
+    return distances
 
 
 def _shortest_distances(problem: Problem, source: str) -> dict[str, Fraction]:
