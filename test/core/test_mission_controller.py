@@ -11,6 +11,7 @@ import pytest
 
 from fjsp_common.vocabulary import EventKind, MissionEventKind, MissionState, RobotMode
 from fjsp_planner.core.mission import (
+    DUE_GRACE,
     IMPROVE_REACH,
     PLAN_RESEND_AFTER,
     EventReport,
@@ -470,6 +471,65 @@ def test_a_job_its_robots_reached_goes_on_when_the_new_plan_keeps_it(problem):
     assert set(tracker.jobs[job].started) == set(assignment.robots)
     fleet.execute()
     assert fleet.state() == MissionState.COMPLETE
+
+
+def test_a_new_plan_that_moves_a_job_fallen_due_is_discarded(problem):
+    """The robots of a job all arrived and its predecessors completed: they start it on
+    those reports, so the planner that has not heard yet they did must not give it to others
+    (they would do it twice); it plans again, and goes on once the starts are heard."""
+    fleet = executing(problem)
+    first = fleet.controller.mission.schedule
+    job, assignment = min(((name, a) for name, a in first.jobs.items() if len(a.robots) > 1),
+                          key=lambda kv: kv[1].start)
+    fleet.wall += float(assignment.start)
+    fleet.execute(until=assignment.start)
+    for robot in assignment.robots:
+        fleet.event(EventKind.ARRIVED, robot, job, float(assignment.start))
+    tracker = fleet.controller.mission.tracker
+    assert tracker.due_start(job) == float(assignment.start)
+    request, outcome = moved_by_a_replan(fleet, job, assignment)
+    effects = fleet.take(fleet.controller.solved(request.token, outcome, fleet.wall))
+    assert not kinds(effects, PublishPlan)
+    (warning,) = notes(effects, MissionEventKind.WARNING)
+    assert f"job '{job}'" in warning.reasons[0]
+    for robot in assignment.robots:
+        fleet.event(EventKind.STARTED, robot, job, float(assignment.start))
+    (again,) = kinds(fleet.tick(), Solve)
+    assert job in again.state.running
+
+
+def test_a_job_fallen_due_long_ago_does_not_hold_a_new_plan_back(problem):
+    """No start heard DUE_GRACE after the job fell due: a report is missing, not on its
+    way, and the new plan is published as it is."""
+    fleet = executing(problem)
+    first = fleet.controller.mission.schedule
+    job, assignment = min(((name, a) for name, a in first.jobs.items() if len(a.robots) > 1),
+                          key=lambda kv: kv[1].start)
+    fleet.wall += float(assignment.start)
+    fleet.execute(until=assignment.start)
+    for robot in assignment.robots:
+        fleet.event(EventKind.ARRIVED, robot, job, float(assignment.start))
+    fleet.wall += 2 * DUE_GRACE / SETTINGS.time_scale
+    request, outcome = moved_by_a_replan(fleet, job, assignment)
+    effects = fleet.take(fleet.controller.solved(request.token, outcome, fleet.wall))
+    (published,) = kinds(effects, PublishPlan)
+    assert job not in published.continued
+
+
+def moved_by_a_replan(fleet, job, assignment):
+    """A robot outside the job's crew fails; the re-plan requested, and its outcome made to
+    give the job to other robots."""
+    out = next(r for r in ROBOTS if r not in assignment.robots)
+    fleet.failures[out] += 1
+    fleet.report(out, RobotMode.FAILED)
+    (request,) = kinds(fleet.tick(), Solve)
+    outcome = repair(request.problem, request.previous, request.state)
+    schedule = outcome.result.schedule
+    others = dict(zip((r for r in ROBOTS if r not in assignment.robots and r != out),
+                      assignment.robots.values(), strict=False))
+    moved = replace(schedule, jobs={**schedule.jobs,
+                                    job: replace(schedule.jobs[job], robots=others)})
+    return request, replace(outcome, result=replace(outcome.result, schedule=moved))
 
 
 def test_a_job_the_new_plan_gives_other_robots_starts_afresh(problem):

@@ -49,6 +49,12 @@ IMPROVE_REACH = 0.5
 """Seconds beyond a search's time limit until its plan reaches the robots (the solver's
 overrun, publishing, the agents taking it): what they do by then is kept in it."""
 
+DUE_GRACE = 1.0
+"""Seconds after a job's start fell due (its robots arrived, its predecessors complete, by
+the reports the planner has) during which its robots' start reports are expected on their
+way: a new plan must let it go on as if it had been reported started. Longer, a report
+must be missing, and the plan is not held back for it."""
+
 RETRY_FAILED_REPLAN = 1.0
 """Seconds after which a re-plan that failed is tried again, if no new report came first."""
 
@@ -843,7 +849,7 @@ class MissionController:
             return self._block(mission, wall, tuple(f're-planned schedule is invalid: {p}'
                                                     for p in replanned.problems))
         continued = frozenset(residual.problem.fixed)
-        progressed = self._progressed(mission, solving.state, residual.problem)
+        progressed = self._progressed(mission, solving, residual.problem, wall)
         if progressed and not self._goes_on(mission, result.schedule, progressed, continued):
             # Restarting these would redo work done meanwhile: plan again from now.
             mission.state = MissionState.EXECUTING
@@ -882,7 +888,7 @@ class MissionController:
             return self._search_longer(mission, solving, outcome.replan, wall)
         better = outcome.replan
         continued = frozenset(better.residual.problem.fixed)
-        progressed = self._progressed(mission, solving.state, better.residual.problem)
+        progressed = self._progressed(mission, solving, better.residual.problem, wall)
         if progressed and not self._goes_on(mission, better.schedule, progressed, continued):
             # The robots got further than the search kept: the plan cannot be followed.
             dropped = Note(MissionEventKind.WARNING, (
@@ -910,16 +916,26 @@ class MissionController:
             return []
         return [self._improve(mission, solving, published, wall, longer)]
 
-    def _progressed(self, mission, posed_state: ExecutionState, posed: Problem) -> list[str]:
-        """Jobs the new plan starts afresh that started or completed since it was posed."""
+    def _progressed(self, mission, solving: _Solving, posed: Problem, wall: float
+                    ) -> list[str]:
+        """Jobs the new plan starts afresh that started or completed since it was posed, or
+        whose start fell due within the last DUE_GRACE seconds: their robots, all available
+        when it was posed, start them on reports the planner has too, so their start
+        reports are on their way."""
         tracker = mission.tracker
+        recent = self._now(mission, wall) - DUE_GRACE / mission.settings.time_scale
         moved = []
         for job in posed.jobs:
             if job.name in posed.fixed:
                 continue
-            record = tracker.jobs[job.name]
-            started_before = job.name in posed_state.running or job.name in posed_state.done
-            if record.begun and not started_before:
+            if job.name in solving.state.running or job.name in solving.state.done:
+                continue
+            if tracker.jobs[job.name].begun:
+                moved.append(job.name)
+                continue
+            due = tracker.due_start(job.name)
+            if due is not None and due >= recent \
+                    and all(r in solving.fleet for r in tracker.plan.jobs[job.name].robots):
                 moved.append(job.name)
         return moved
 
@@ -929,7 +945,8 @@ class MissionController:
         and each of those robots does them first, in the order it began them, before any
         job the plan starts afresh — so every robot's next leg leaves from where it is."""
         tracker = mission.tracker
-        order = sorted(progressed, key=lambda job: tracker.jobs[job].start)
+        order = sorted(progressed, key=lambda job: tracker.jobs[job].start
+                       if tracker.jobs[job].begun else tracker.due_start(job))
         for job in order:
             running, new = tracker.plan.jobs[job], schedule.jobs.get(job)
             if new is None or new.plan != running.plan \

@@ -355,6 +355,22 @@ class MissionTracker:
         return frozenset(name for name, r in self.jobs.items()
                          if r.end is None and r.started)
 
+    def due_start(self, job: str) -> float | None:
+        """When the robots of a job not begun start it, by the reports so far: every robot
+        the plan gives it has arrived and every predecessor has completed. None otherwise.
+        The robots start it on the same reports, so they may have started it before the
+        planner hears of it."""
+        record = self.jobs[job]
+        planned = self.plan.jobs.get(job) if self.plan is not None else None
+        if planned is None or record.begun or record.aborted:
+            return None
+        if any(robot not in record.arrived for robot in planned.robots):
+            return None
+        ends = [self.jobs[before].end for before in self.problem.predecessors(job)]
+        if None in ends:
+            return None
+        return max([record.arrived[robot] for robot in planned.robots] + ends)
+
     @property
     def aborted(self) -> frozenset[str]:
         return frozenset(name for name, r in self.jobs.items() if r.aborted)
