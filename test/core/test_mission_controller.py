@@ -5,6 +5,7 @@ controller asks for is run here for real, through the same functions the node ca
 """
 
 from dataclasses import replace
+from fractions import Fraction
 from pathlib import Path
 
 import pytest
@@ -26,6 +27,7 @@ from fjsp_planner.core.mission import (
 )
 from fjsp_planner.core.replan import Improvement, Replan, improve, repair
 from fjsp_planner.core.scenario import load_scenario
+from fjsp_planner.core.schedule import Schedule
 from fjsp_planner.core.solve import solve
 
 SCENARIO = Path(__file__).resolve().parents[2] / 'config' / 'scenarios' / 'solar_panel.yaml'
@@ -530,6 +532,41 @@ def moved_by_a_replan(fleet, job, assignment):
     moved = replace(schedule, jobs={**schedule.jobs,
                                     job: replace(schedule.jobs[job], robots=others)})
     return request, replace(outcome, result=replace(outcome.result, schedule=moved))
+
+
+def test_a_job_whose_robot_first_redoes_a_job_begun_starts_afresh(problem):
+    """A robot at a job is sent first to redo a job begun elsewhere (its robot went offline
+    on it): the job it waits at is no longer its next, so its arrival there must not let the
+    others start it without it."""
+    fleet = executing(problem)
+    first = fleet.controller.mission.schedule
+    job, assignment = min(((name, a) for name, a in first.jobs.items() if len(a.robots) > 1),
+                          key=lambda kv: kv[1].start)
+    begun, running = max(((name, a) for name, a in first.jobs.items()
+                          if name in problem.predecessors(job)), key=lambda kv: kv[1].start)
+    (lost,) = running.robots
+    assert lost not in assignment.robots
+    fleet.wall += float(running.start)
+    fleet.execute(until=running.start + Fraction(1, 2))
+    for robot in assignment.robots:
+        fleet.event(EventKind.ARRIVED, robot, job, float(running.start))
+    done = fleet.controller.mission.tracker.done
+    effects = fleet.tick(advance=1.5, robots=[r for r in ROBOTS if r != lost])
+    (request,) = kinds(effects, Solve)
+    outcome = repair(request.problem, request.previous, request.state)
+    # The first plan as it was, but for the begun job, redone first by a robot of the job.
+    helper = next(iter(assignment.robots))
+    jobs = {name: a for name, a in first.jobs.items() if name not in done}
+    jobs[begun] = replace(running, robots={helper: next(iter(running.robots.values()))})
+    sequences = {robot: tuple(j for j in sequence if j in jobs and j != begun)
+                 for robot, sequence in first.sequences.items()}
+    sequences[helper] = (begun, *sequences[helper])
+    outcome = replace(outcome, result=replace(outcome.result,
+                                              schedule=Schedule(jobs, sequences)))
+    (published,) = kinds(fleet.controller.solved(request.token, outcome, fleet.wall),
+                         PublishPlan)
+    assert begun not in published.continued
+    assert job not in published.continued
 
 
 def test_a_job_the_new_plan_gives_other_robots_starts_afresh(problem):

@@ -968,18 +968,18 @@ class MissionController:
         tracker = mission.tracker
         old = tracker.plan
 
-        def open_job(job: str) -> bool:
-            return job not in continued and not tracker.jobs[job].begun
-
         def same(job: str) -> bool:
-            was, new = old.jobs.get(job), schedule.jobs.get(job)
-            return (was is not None and new is not None and not tracker.jobs[job].aborted
-                    and new.plan == was.plan and dict(new.robots) == dict(was.robots))
+            was, new, record = old.jobs.get(job), schedule.jobs.get(job), tracker.jobs[job]
+            return (was is not None and new is not None and not record.begun
+                    and not record.aborted and new.plan == was.plan
+                    and dict(new.robots) == dict(was.robots))
 
         heads = {}
         for robot, sequence in schedule.sequences.items():
-            before = [job for job in old.sequences.get(robot, ()) if open_job(job)]
-            after = [job for job in sequence if open_job(job)]
+            # A job begun and started afresh is still ahead of its robots in both orders.
+            before = [job for job in old.sequences.get(robot, ())
+                      if job not in continued and tracker.jobs[job].end is None]
+            after = [job for job in sequence if job not in continued]
             head = []
             for a, b in zip(before, after, strict=False):
                 if a != b or not same(a):
