@@ -569,6 +569,26 @@ def test_a_job_whose_robot_first_redoes_a_job_begun_starts_afresh(problem):
     assert job not in published.continued
 
 
+def test_a_job_a_restarted_robot_had_reached_starts_afresh(problem):
+    """The agent of a robot waiting at a job restarted: its new process does not know it
+    waits there, so its arrival must not let the others start the job without it."""
+    fleet = executing(problem)
+    first = fleet.controller.mission.schedule
+    job, assignment = min(((name, a) for name, a in first.jobs.items() if len(a.robots) > 1),
+                          key=lambda kv: kv[1].start)
+    fleet.wall += float(assignment.start)
+    fleet.execute(until=assignment.start)
+    for robot in assignment.robots:
+        fleet.event(EventKind.ARRIVED, robot, job, float(assignment.start))
+    restarted = next(iter(assignment.robots))
+    fleet.incarnations[restarted] += 1
+    request = fleet.tick_until_solve()
+    assert f"robot '{restarted}' restarted: its agent lost its tasks" in request.reasons
+    (published,) = kinds(fleet.run_solves([request]), PublishPlan)
+    assert job not in published.continued
+    assert fleet.controller.mission.tracker.jobs[job].arrived == {}
+
+
 def test_a_job_the_new_plan_gives_other_robots_starts_afresh(problem):
     """Going on is for jobs the new plan leaves as they were: one that a failed robot was
     waiting at is started afresh, its arrivals void."""

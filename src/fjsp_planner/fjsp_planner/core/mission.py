@@ -920,10 +920,11 @@ class MissionController:
                     ) -> list[str]:
         """Jobs the new plan starts afresh that started or completed since it was posed, or
         whose start fell due within the last DUE_GRACE seconds: their robots, all available
-        when it was posed, start them on reports the planner has too, so their start
-        reports are on their way."""
+        when it was posed and none failed or restarted since the current plan, start them
+        on reports the planner has too, so their start reports are on their way."""
         tracker = mission.tracker
         recent = self._now(mission, wall) - DUE_GRACE / mission.settings.time_scale
+        shaken = tracker.failed_since(tracker.revision)
         moved = []
         for job in posed.jobs:
             if job.name in posed.fixed:
@@ -934,8 +935,10 @@ class MissionController:
                 moved.append(job.name)
                 continue
             due = tracker.due_start(job.name)
-            if due is not None and due >= recent \
-                    and all(r in solving.fleet for r in tracker.plan.jobs[job.name].robots):
+            if due is None or due < recent:
+                continue
+            robots = tracker.plan.jobs[job.name].robots
+            if not shaken & set(robots) and all(r in solving.fleet for r in robots):
                 moved.append(job.name)
         return moved
 
@@ -961,18 +964,21 @@ class MissionController:
 
     def _unchanged(self, mission, schedule: Schedule, continued) -> frozenset[str]:
         """Jobs not begun that the new plan leaves as the old one had them: the same plan and
-        robots, and for each of those robots next in both the old and the new order, after
-        what goes on. They go on rather than start afresh: a robot may have arrived at one,
-        or started it, on reports still on their way to the planner, and starting it afresh
-        would void those arrivals and have its robots do it twice."""
+        robots, none of which failed or restarted since the old plan, and for each of those
+        robots next in both the old and the new order, after what goes on. They go on rather
+        than start afresh: a robot may have arrived at one, or started it, on reports still
+        on their way to the planner, and starting it afresh would void those arrivals and
+        have its robots do it twice."""
         tracker = mission.tracker
         old = tracker.plan
+        # What a robot that failed or restarted since reported no longer holds.
+        shaken = tracker.failed_since(tracker.revision)
 
         def same(job: str) -> bool:
             was, new, record = old.jobs.get(job), schedule.jobs.get(job), tracker.jobs[job]
             return (was is not None and new is not None and not record.begun
                     and not record.aborted and new.plan == was.plan
-                    and dict(new.robots) == dict(was.robots))
+                    and dict(new.robots) == dict(was.robots) and not shaken & set(new.robots))
 
         heads = {}
         for robot, sequence in schedule.sequences.items():
