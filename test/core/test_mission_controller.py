@@ -441,12 +441,9 @@ def test_jobs_done_while_replanning_are_not_redone(problem):
         assert f"robot '{out}' failed" in again.reasons
 
 
-def test_a_job_its_robots_reached_goes_on_when_the_new_plan_keeps_it(problem):
-    """A re-plan published while the robots of a job start it, their reports still on the
-    way: the job goes on under the new revision, so those reports count, rather than being
-    voided and the job done twice."""
-    from fjsp_planner.core.extension import extend
-
+def at_the_first_crew_job(problem):
+    """A mission executed to plan until its first job of several robots, which have all
+    reported arriving there; (the fleet, that job, its assignment)."""
     fleet = executing(problem)
     first = fleet.controller.mission.schedule
     job, assignment = min(((name, a) for name, a in first.jobs.items() if len(a.robots) > 1),
@@ -455,6 +452,16 @@ def test_a_job_its_robots_reached_goes_on_when_the_new_plan_keeps_it(problem):
     fleet.execute(until=assignment.start)
     for robot in assignment.robots:
         fleet.event(EventKind.ARRIVED, robot, job, float(assignment.start))
+    return fleet, job, assignment
+
+
+def test_a_job_its_robots_reached_goes_on_when_the_new_plan_keeps_it(problem):
+    """A re-plan published while the robots of a job start it, their reports still on the
+    way: the job goes on under the new revision, so those reports count, rather than being
+    voided and the job done twice."""
+    from fjsp_planner.core.extension import extend
+
+    fleet, job, assignment = at_the_first_crew_job(problem)
     tracker = fleet.controller.mission.tracker
     extended, added = extend(problem, 'jobs: [{name: Inspect, location: Ad, plans: '
                              '[[locomote]]}]\nprecedence: [[Ad, Inspect]]\n',
@@ -479,14 +486,7 @@ def test_a_new_plan_that_moves_a_job_fallen_due_is_discarded(problem):
     """The robots of a job all arrived and its predecessors completed: they start it on
     those reports, so the planner that has not heard yet they did must not give it to others
     (they would do it twice); it plans again, and goes on once the starts are heard."""
-    fleet = executing(problem)
-    first = fleet.controller.mission.schedule
-    job, assignment = min(((name, a) for name, a in first.jobs.items() if len(a.robots) > 1),
-                          key=lambda kv: kv[1].start)
-    fleet.wall += float(assignment.start)
-    fleet.execute(until=assignment.start)
-    for robot in assignment.robots:
-        fleet.event(EventKind.ARRIVED, robot, job, float(assignment.start))
+    fleet, job, assignment = at_the_first_crew_job(problem)
     tracker = fleet.controller.mission.tracker
     assert tracker.due_start(job) == float(assignment.start)
     request, outcome = moved_by_a_replan(fleet, job, assignment)
@@ -503,14 +503,7 @@ def test_a_new_plan_that_moves_a_job_fallen_due_is_discarded(problem):
 def test_a_job_fallen_due_long_ago_does_not_hold_a_new_plan_back(problem):
     """No start heard DUE_GRACE after the job fell due: a report is missing, not on its
     way, and the new plan is published as it is."""
-    fleet = executing(problem)
-    first = fleet.controller.mission.schedule
-    job, assignment = min(((name, a) for name, a in first.jobs.items() if len(a.robots) > 1),
-                          key=lambda kv: kv[1].start)
-    fleet.wall += float(assignment.start)
-    fleet.execute(until=assignment.start)
-    for robot in assignment.robots:
-        fleet.event(EventKind.ARRIVED, robot, job, float(assignment.start))
+    fleet, job, assignment = at_the_first_crew_job(problem)
     fleet.wall += 2 * DUE_GRACE / SETTINGS.time_scale
     request, outcome = moved_by_a_replan(fleet, job, assignment)
     effects = fleet.take(fleet.controller.solved(request.token, outcome, fleet.wall))
@@ -572,14 +565,7 @@ def test_a_job_whose_robot_first_redoes_a_job_begun_starts_afresh(problem):
 def test_a_job_a_restarted_robot_had_reached_starts_afresh(problem):
     """The agent of a robot waiting at a job restarted: its new process does not know it
     waits there, so its arrival must not let the others start the job without it."""
-    fleet = executing(problem)
-    first = fleet.controller.mission.schedule
-    job, assignment = min(((name, a) for name, a in first.jobs.items() if len(a.robots) > 1),
-                          key=lambda kv: kv[1].start)
-    fleet.wall += float(assignment.start)
-    fleet.execute(until=assignment.start)
-    for robot in assignment.robots:
-        fleet.event(EventKind.ARRIVED, robot, job, float(assignment.start))
+    fleet, job, assignment = at_the_first_crew_job(problem)
     restarted = next(iter(assignment.robots))
     fleet.incarnations[restarted] += 1
     request = fleet.tick_until_solve()
@@ -592,14 +578,7 @@ def test_a_job_a_restarted_robot_had_reached_starts_afresh(problem):
 def test_a_job_the_new_plan_gives_other_robots_starts_afresh(problem):
     """Going on is for jobs the new plan leaves as they were: one that a failed robot was
     waiting at is started afresh, its arrivals void."""
-    fleet = executing(problem)
-    first = fleet.controller.mission.schedule
-    job, assignment = min(((name, a) for name, a in first.jobs.items() if len(a.robots) > 1),
-                          key=lambda kv: kv[1].start)
-    fleet.wall += float(assignment.start)
-    fleet.execute(until=assignment.start)
-    for robot in assignment.robots:
-        fleet.event(EventKind.ARRIVED, robot, job, float(assignment.start))
+    fleet, job, assignment = at_the_first_crew_job(problem)
     out = next(r for r in assignment.robots if r != 'Assembler')
     fleet.failures[out] += 1
     fleet.report(out, RobotMode.FAILED)
