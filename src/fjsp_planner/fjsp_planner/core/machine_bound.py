@@ -251,14 +251,16 @@ def _solve(jobs, lags, holds, kind_of, travel, time_limit, workers, subsolvers
     """(a, i, b, j) -> least time between the end of the job a holds into and b's start,
     when b comes after a with choice j and shares a robot with a's choice i: a's robots
     hold on into that job before they can go."""
-    for a, b in ((a, b) for a in held for b in range(len(jobs)) if b not in (a, held[a])):
+    for a, b in itertools.product(held, range(len(jobs))):
+        if b in (a, held[a]):
+            continue
         for i, first in enumerate(jobs[a][4]):
             for j, second in enumerate(jobs[b][4]):
                 found = least_gap(held[a], first, b, second)
                 if found is not None:
                     after_hold[a, i, b, j] = found
     values = [v for job in jobs for v in (job[2], job[3], *(c.duration for c in job[4]))]
-    values += list(lag.values()) + list(moves.values())
+    values += list(lag.values()) + list(moves.values()) + list(after_hold.values())
     scale = min(MAX_GRID, math.lcm(*(v.denominator for v in values)))
 
     def ticks(value):
