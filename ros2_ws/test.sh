@@ -10,7 +10,7 @@ cd "$(dirname "$WS")"
 
 ruff check .
 status=0
-pytest test/ "$@" || status=$?
+pytest test/ --durations=15 "$@" || status=$?
 # pytest exits 5 when it collected nothing: for this suite that is a failure too.
 if [[ $status -eq 5 ]]; then
   echo "test.sh: pytest collected no tests" >&2
