@@ -21,6 +21,7 @@ from fjsp_planner.core.machine_bound import MAX_JOBS, panel_machine_bound
 from fjsp_planner.core.problem import Job, Problem, Robot
 from fjsp_planner.core.scenario import load_scenario, repeat_panels
 from fjsp_planner.core.schedule import Status
+from fjsp_planner.core.sequence_bound import MAX_PANELS, panel_sequence_bound
 from fjsp_planner.core.solve import solve
 from fjsp_planner.core.validate import validate
 
@@ -142,6 +143,32 @@ def test_machine_bound_counts_the_shortest_way_not_the_direct_one():
     assert panel_machine_bound(problem, Fraction(12), 20) == 11
 
 
+def test_sequence_bound_counts_the_shortest_way_not_the_direct_one():
+    """A is all of G, so every job is heavy: its six jobs run one after another, 1 each, and
+    between two of them A moves at least 1 (the shortest way, through b when the direct one
+    is 10): 6 + 5 = 11, the optimum (proven above)."""
+    assert panel_sequence_bound(detour(2), Fraction(12), 20) == 11
+
+
+def test_sequence_bound_on_the_paper_three_panels():
+    """The heavy jobs of 3 panels, in the best order the relaxation has: a panel without the
+    Assembler from 1 (LSMS moves M1 first) to 54 1/6 (its seven heavy jobs take 45; between
+    `Ab` and `Ac` LSMS goes to M3, 35/30, moves it, 1, and a MARC holds `Jc`, 5; `Md`, 1),
+    both MARCs on to the next panel (MARC2 crosses in 12) for `Aa` and `Ab` with the
+    Assembler, 5 each, to 76 1/6, on again (12) to the third panel, done without the
+    Assembler from 88 1/6 to 141 1/3. Above the load bound's 132 and below the best known
+    schedule, 153 1/6 (bench/solve_panels.py)."""
+    problem = load_scenario(PAPER, panels=3)
+    assert panel_sequence_bound(problem, Fraction(919, 6), 30) == Fraction(424, 3)
+
+
+def test_sequence_bound_stays_out_of_many_panels():
+    """Its states grow as the product of the panels' progress; the load bound speaks for
+    more panels."""
+    problem = load_scenario(PAPER, panels=MAX_PANELS + 1)
+    assert panel_sequence_bound(problem, Fraction(400), 1) is None
+
+
 def test_machine_bound_on_the_paper_two_panels():
     """docs/solver.md, "Panel machine": the heavy jobs of the panel without the Assembler,
     the Assembler's holds in the other panel, and every pair of jobs that share a robot kept
@@ -214,6 +241,7 @@ def test_every_bound_stays_below_mip_proven_optima(seed, optimum):
     for name, found in [
             ('machine', panel_machine_bound(problem, incumbent, 30)),
             ('load', panel_load_bound(problem, incumbent, 30)),
+            ('sequence', panel_sequence_bound(problem, incumbent, 30)),
             ('energy', bounds.panel_energy_bound(problem, incumbent)),
             ('clique', bounds.panel_clique_bound(problem, incumbent)),
             ('critical path', bounds.critical_path_bound(problem))]:
@@ -262,7 +290,7 @@ def places_panel(seed: int) -> Problem:
 
 @pytest.mark.parametrize(('panels', 'seed', 'optimum'), [
     (2, 0, 11), (2, 3, 6), (2, 12, 14), (2, 22, 5), (3, 0, 18), (3, 3, 9), (3, 4, 10)])
-def test_load_and_machine_bounds_stay_below_proven_optima(panels, seed, optimum):
+def test_load_machine_and_sequence_bounds_stay_below_proven_optima(panels, seed, optimum):
     """Panels of `places_panel`, 1 to 3 apart. The optima are CP-SAT's, proven; the MIP,
     which has no panel cut, proves the same on the 2-panel ones (40-80 s each, so not here).
     Both bounds meet the optimum on all but (2, 0) and (3, 0): a travel count one move too
@@ -274,6 +302,8 @@ def test_load_and_machine_bounds_stay_below_proven_optima(panels, seed, optimum)
     for found in (panel_load_bound(problem, exact.makespan + 1, 30),
                   panel_machine_bound(problem, exact.makespan + 1, 30)):
         assert found is not None and found <= optimum
+    sequence = panel_sequence_bound(problem, exact.makespan + 1, 30)
+    assert sequence is None or sequence <= optimum
 
 
 def test_load_bound_on_the_tiny_panels(two_panels_optimum):

@@ -1,0 +1,413 @@
+"""A lower bound for identical panels that knows where each panel lies: the "panel sequence"
+bound (docs/solver.md, "Bounds").
+
+Let G be the robots that can reach every panel within a known schedule's makespan U (the
+others, "limited", reach only `bounds.panel_limits` many), and call a staffing *heavy* when
+it needs more than half of G. Two heavy staffings together need more of G than there is, so
+in any schedule the jobs staffed heavily, over all panels, run one after another, and a
+limited robot does one job at a time. The relaxation keeps, per panel, the jobs that have
+no staffing that is neither heavy nor has a limited robot (the others can always be done by
+few robots of G and are forgotten), and orders them all by their start times. A job then
+starts no earlier than:
+
+- its head (the least time precedence chains need before it, `machine_bound._panel_shape`);
+- when heavy, the end of the heavy job before it plus the least travel of the slowest robot
+  both share, along the places of the panels *where they lie* (the paper's panels lie in a
+  row: from the fifth back to the second is three crossings), or the lag a precedence chain
+  puts between the two when they are of one panel;
+- when it has a limited robot, the end of that robot's job before it plus its least travel
+  from there;
+- the end of either of those plus the lag of a chain from it, when it precedes the job.
+
+A jig job staffed heavily whose robots all hold into another job is directly followed by it
+among the heavy ones (its robots are busy until the held job ends, and any other heavy job
+shares one of them). At most the sum of the limits of panels have jobs a limited robot works
+on; the others are staffed from G. Its value is the least makespan over such orders, each
+job at its least duration for the robots chosen plus the least time after its end (its
+tail), over every choice of the panels the limited robots may work in: a best-first search
+over (the panels they may work in, which jobs of each panel are done, the last heavy one and
+each limited robot's last one), with an estimate of what is left that never overstates it
+(the least durations of the jobs only heavy staffings can do, the lags or switches between
+them and one switch into each panel left, a switch costing at least its travel and how much
+longer the job after it takes than its least).
+
+It forgets lags between jobs whose ends it does not keep, the routes of robots of G between
+jobs that are not consecutive heavy ones, and which robot of a set does what. Every schedule
+shorter than U is one of these orders, so the search's least value, or the least value still
+open when its time runs out, bounds every schedule shorter than U, and min(bound, U) bounds
+all. CP-SAT's model of a similar relaxation (`machine_bound`), which knows no panel's place,
+proves about 200 on 5 panels of the paper in minutes.
+"""
+
+import heapq
+import itertools
+import math
+import time
+from fractions import Fraction
+
+from fjsp_planner.core.bounds import panel_limits
+from fjsp_planner.core.machine_bound import _panel_shape, _within
+from fjsp_planner.core.problem import Problem
+
+MAX_PANELS = 6
+"""Above this many panels the search is not run: its states grow as the product of the
+panels' progress (12 per panel of the paper), and the panel load bound proves more in the
+time."""
+MAX_PANEL_JOBS = 12
+"""Above this many kept jobs in a panel the search is not run: what is left of a panel is
+estimated over every set of its jobs done (2^12 sets)."""
+MAX_GRID = 1000
+MAX_OPEN = 500_000
+"""The search stops, with the least value still open, when it has this many orders open
+(about 300 MB with what it has closed): 5 panels of the paper reach it in about 6 s."""
+
+
+def panel_sequence_bound(problem: Problem, incumbent: Fraction, time_limit: float
+                         ) -> Fraction | None:
+    """The bound of the module docstring, or None when it does not apply (fewer than two
+    or more than MAX_PANELS panels, running jobs, no robot of G, no job kept or more than
+    MAX_PANEL_JOBS of them in a panel)."""
+    panels = len(problem.panels)
+    if not 2 <= panels <= MAX_PANELS or problem.fixed:
+        return None
+    deadline = time.monotonic() + time_limit
+    limits = panel_limits(problem, incumbent)
+    group = frozenset(r.name for r in problem.robots if r.name not in limits)
+    if not group:
+        return None
+    bare = _kept_jobs(problem, sorted(group), group, set(limits), incumbent)
+    helped_count = min(panels, sum(limits.values()))
+    helped = (_kept_jobs(problem, sorted(r.name for r in problem.robots), group,
+                         set(limits), incumbent) if helped_count else bare)
+    if bare is None or helped is None or not (bare[0] or helped[0]) or max(
+            len(bare[0]), len(helped[0])) > MAX_PANEL_JOBS:
+        return None
+    search = _Search(problem, bare, helped, sorted(limits), incumbent)
+    layouts = search.layouts(helped_count)
+    return min(search.run(layouts, deadline), incumbent)
+
+
+def _kept_jobs(problem, allowed, group, limited, incumbent):
+    """(jobs, lags, holds) of one panel staffed from `allowed`, keeping the jobs each choice
+    of which is heavy or has a limited robot, or None if some job cannot be staffed."""
+    shape = _panel_shape(problem, allowed, group, limited)
+    if shape is None:
+        return None
+    jobs, lags, holds = _within(shape, incumbent, every_job=True)
+    kept = [job for job in jobs if all(c.heavy or c.limited for c in job[3])]
+    names = {job[0] for job in kept}
+    return (kept, {key: lag for key, lag in lags.items() if set(key) <= names},
+            {(a, b) for a, b in holds if a in names and b in names})
+
+
+class _Search:
+    """The best-first search of the module docstring, on an integer time grid (every time
+    floored onto it, which only lowers the bound)."""
+
+    def __init__(self, problem, bare, helped, limited, incumbent):
+        self.limited = limited
+        self.panels = len(problem.panels)
+        names = problem.panels[0]
+        paths = _Paths(problem)
+        kept = sorted({job[0] for shape in (bare, helped) for job in shape[0]})
+        copies = [(k, n, problem.panels[k][names.index(n)]) for k in range(self.panels)
+                  for n in kept]
+        travel = {(r.name, k, a, m, b): paths.travel(r.name, x, y)
+                  for r in problem.robots for k, a, x in copies for m, b, y in copies}
+        values = [v for shape in (bare, helped) for _, head, tail, choices in shape[0]
+                  for v in (head, tail, *(c.duration for c in choices))]
+        values += [v for shape in (bare, helped) for v in shape[1].values()]
+        values += list(travel.values()) + [incumbent]
+        scale = min(MAX_GRID, math.lcm(*(v.denominator for v in values)))
+        self.scale = scale
+
+        def ticks(value):
+            return value.numerator * scale // value.denominator
+
+        self.travel = {key: ticks(v) for key, v in travel.items()}
+        self.bare, self.helped = _Shape(bare, ticks), _Shape(helped, ticks)
+        self.incumbent = ticks(incumbent)
+        self.switch = self._least_switch()
+        for shape in (self.bare, self.helped):
+            shape.rest = _rest_costs(shape, self.switch)
+
+    def layouts(self, helped_count):
+        """Every set of `helped_count` panels, one of each pair of mirror images when the
+        travel between panels reads the same from the other end."""
+        last = self.panels - 1
+        mirrored = all(value == self.travel[r, last - k, a, last - m, b]
+                       for (r, k, a, m, b), value in self.travel.items())
+        chosen = []
+        for helped in itertools.combinations(range(self.panels), helped_count):
+            mirror = tuple(sorted(last - k for k in helped))
+            if not (mirrored and mirror in chosen):
+                chosen.append(helped)
+        return [tuple(self.helped if k in helped else self.bare for k in range(self.panels))
+                for helped in chosen]
+
+    def gap(self, k, first, a, m, second, b):
+        """Least time from job a's end (panel k, `first` choice) to job b's start (panel m,
+        `second`) for the robots both choices share to get there."""
+        least = None
+        for x in first.sets:
+            for y in second.sets:
+                shared = x & y
+                if not shared:
+                    return 0
+                found = max(self.travel[r, k, a, m, b] for r in shared)
+                least = found if least is None else min(least, found)
+        return least
+
+    def _least_switch(self):
+        """Least cost of going on, among heavy jobs, with one of another panel: the gap (for
+        each shared robot its least travel between copies of the two jobs in two panels)
+        and how much longer the second takes than its least (a job is the second of one
+        switch at most, so this counts no time twice)."""
+        across = {}
+        for (r, k, a, m, b), value in self.travel.items():
+            if k != m:
+                across[r, a, b] = min(value, across.get((r, a, b), value))
+        least = None
+        shapes = (self.bare, self.helped)
+        for first, second in itertools.product(shapes, shapes):
+            for i, j in itertools.product(range(len(first.names)), range(len(second.names))):
+                if not (first.always_heavy[i] and second.always_heavy[j]):
+                    continue
+                a, b = first.names[i], second.names[j]
+                for ci, cj in itertools.product(first.choices[i], second.choices[j]):
+                    shared = [x & y for x in ci.sets for y in cj.sets]
+                    gap = min(max((across[r, a, b] for r in robots), default=0)
+                              for robots in shared)
+                    found = gap + cj.duration - second.least[j]
+                    least = found if least is None else min(least, found)
+        return least or 0
+
+    def _eager(self, shape, k, j, choice, last, where, recent) -> bool:
+        """Whether job j of panel k, staffed lightly by `choice` (so with a limited robot),
+        may come now: right after what must come before it, the job before it on a limited
+        robot of the choice or a job it follows by precedence. Every order of a schedule
+        can be rearranged so, its light jobs each moved up to right after the last of those
+        (which only drops constraints of the order), so the search keeps no other orders
+        and loses nothing."""
+        if recent is None:
+            if last is None:
+                return not shape.before[j] and all(w is None for w in where)
+            p, i, _ = last
+            recent = (p, i)
+        q, m = recent
+        if q == k and shape.before[j] >> m & 1:
+            return True
+        return any(where[n] == recent for n, robot in enumerate(self.limited)
+                   if robot in choice.limited)
+
+    def run(self, layouts, deadline) -> Fraction:
+        """The least makespan of the relaxation over `layouts` (per panel, its shape), or the
+        least value still open when the deadline comes (a lower bound either way); the
+        incumbent when no order ends before it."""
+        limited, switch, travel = self.limited, self.switch, self.travel
+        robots = range(len(limited))
+
+        def estimate(shapes, progress, last_panel, last_job):
+            left, tail, others = 0, None, 0
+            for k, shape in enumerate(shapes):
+                done = progress[k]
+                if done & shape.heavy_mask == shape.heavy_mask:
+                    continue
+                left += shape.left[done]
+                tail = shape.least_tail[done] if tail is None else min(
+                    tail, shape.least_tail[done])
+                if k == last_panel:
+                    left += shape.rest[done, last_job]
+                else:
+                    left += shape.rest[done, -1]
+                    others += 1
+            return left + others * switch + (tail or 0)
+
+        counter = itertools.count()
+        frontier = []
+        for layout, shapes in enumerate(layouts):
+            progress = tuple(0 for _ in shapes)
+            state = (layout, progress, None, tuple(None for _ in robots), None)
+            frontier.append((estimate(shapes, progress, None, -1), next(counter), state, 0, 0,
+                             tuple(0 for _ in robots)))
+        heapq.heapify(frontier)
+        closed, gaps = {}, {}
+        expansions = 0
+        while frontier:
+            expansions += 1
+            if expansions % 512 == 0 and (time.monotonic() > deadline
+                                          or len(frontier) > MAX_OPEN):
+                return Fraction(frontier[0][0], self.scale)
+            value, _, state, now, latest, ends = heapq.heappop(frontier)
+            layout, progress, last, where, recent = state
+            shapes = layouts[layout]
+            if all(done == shape.full for done, shape in zip(progress, shapes, strict=True)):
+                return Fraction(value, self.scale)
+            labels = closed.setdefault(state, [])
+            if any(t <= now and m <= latest and all(a <= b for a, b in zip(e, ends, strict=True))
+                   for t, m, e in labels):
+                continue
+            labels.append((now, latest, ends))
+            forced = None
+            if last is not None:
+                p, i, last_choice = last
+                held = shapes[p].held.get(i)
+                if held is not None and not progress[p] >> held & 1:
+                    forced = (p, held)
+            for k, shape in enumerate(shapes):
+                done = progress[k]
+                for j in range(len(shape.names)):
+                    if done >> j & 1 or shape.before[j] & ~done:
+                        continue
+                    after = progress[:k] + (done | 1 << j,) + progress[k + 1:]
+                    rest = None
+                    for choice in shape.choices[j]:
+                        begin = shape.heads[j]
+                        if choice.heavy:
+                            if forced is not None and (forced != (k, j) or not any(
+                                    a <= b for a in last_choice.sets for b in choice.sets)):
+                                continue
+                            if last is not None:
+                                key = (p, i, last_choice, k, j, choice)
+                                gap = gaps.get(key)
+                                if gap is None:
+                                    gap = self.gap(p, last_choice, shapes[p].names[i], k,
+                                                   choice, shape.names[j])
+                                    if p == k:
+                                        gap = max(gap, shape.lags.get((i, j), 0))
+                                    gaps[key] = gap
+                                begin = max(begin, now + gap)
+                        else:
+                            if not self._eager(shape, k, j, choice, last, where, recent):
+                                continue
+                            if last is not None and p == k:
+                                begin = max(begin, now + shape.lags.get((i, j), 0))
+                        moved = list(where)
+                        for n in robots:
+                            if where[n] is None:
+                                continue
+                            q, m = where[n]
+                            if limited[n] in choice.limited:
+                                begin = max(begin, ends[n] + travel[
+                                    limited[n], q, shapes[q].names[m], k, shape.names[j]])
+                            if q == k:
+                                begin = max(begin, ends[n] + shape.lags.get((m, j), 0))
+                        end = begin + choice.duration
+                        new_ends = list(ends)
+                        for n in robots:
+                            if limited[n] in choice.limited:
+                                new_ends[n], moved[n] = end, (k, j)
+                        new_latest = max(latest, end + shape.tails[j])
+                        if choice.heavy:
+                            new_now, new_last, new_recent = end, (k, j, choice), None
+                            if rest is None:
+                                rest = estimate(shapes, after, k, j)
+                            bound = max(new_latest, end + rest)
+                        else:
+                            new_now, new_last, new_recent = now, last, (k, j)
+                            bound = max(new_latest, now + estimate(
+                                shapes, after, p if last else None, i if last else -1))
+                        if bound >= self.incumbent:
+                            continue
+                        heapq.heappush(frontier, (
+                            bound, next(counter),
+                            (layout, after, new_last, tuple(moved), new_recent),
+                            new_now, new_latest, tuple(new_ends)))
+        return Fraction(self.incumbent, self.scale)
+
+
+class _Shape:
+    """The kept jobs of one panel on the grid: names, heads, tails, choices (durations in
+    ticks), which jobs must come first (bit masks), lags, holds, the jobs only heavy
+    staffings can do, and per set of jobs done the least durations of those left and the
+    least tail among them."""
+
+    def __init__(self, shape, ticks):
+        jobs, lags, holds = shape
+        self.names = [name for name, *_ in jobs]
+        self.heads = [ticks(head) for _, head, _, _ in jobs]
+        self.tails = [ticks(tail) for _, _, tail, _ in jobs]
+        self.choices = [[_Choice(ticks(c.duration), c.sets, c.heavy, c.limited)
+                         for c in choices] for *_, choices in jobs]
+        index = {name: k for k, name in enumerate(self.names)}
+        self.before = [sum(1 << index[a] for (a, b) in lags if b == name)
+                       for name in self.names]
+        self.lags = {(index[a], index[b]): ticks(lag) for (a, b), lag in lags.items()}
+        self.held = {index[a]: index[b] for a, b in holds}
+        self.least = [min(c.duration for c in choices) for choices in self.choices]
+        self.always_heavy = [all(c.heavy for c in choices) for choices in self.choices]
+        count = len(self.names)
+        self.full = (1 << count) - 1
+        self.heavy_mask = sum(1 << j for j in range(count) if self.always_heavy[j])
+        heavy_left = [[j for j in range(count) if self.always_heavy[j] and not done >> j & 1]
+                      for done in range(self.full + 1)]
+        self.left = [sum(self.least[j] for j in left) for left in heavy_left]
+        self.least_tail = [min((self.tails[j] for j in left), default=0)
+                           for left in heavy_left]
+        self.rest = {}
+
+
+class _Choice:
+    def __init__(self, duration, sets, heavy, limited):
+        self.duration, self.sets, self.heavy, self.limited = duration, sets, heavy, limited
+
+
+def _rest_costs(shape, switch):
+    """(jobs done, the last heavy one or -1) -> least sum, over the orders of the jobs left
+    that only heavy staffings can do, of what separates consecutive ones: the lag between
+    them when one comes right after the other among the heavy jobs, or a switch to another
+    panel and back when not, whichever is less (the switch into the panel is counted by the
+    caller, once per panel)."""
+    rest = {}
+    heavy = [j for j in range(len(shape.names)) if shape.always_heavy[j]]
+    for done in range(shape.full, -1, -1):
+        for last in range(-1, len(shape.names)):
+            left = [j for j in heavy if not done >> j & 1]
+            if not left:
+                rest[done, last] = 0
+                continue
+            best = None
+            for j in left:
+                before = shape.before[j] & shape.heavy_mask
+                if before & ~done:
+                    continue
+                step = 0 if last < 0 else min(shape.lags.get((last, j), 0), switch)
+                found = step + rest[done | 1 << j, j]
+                best = found if best is None else min(best, found)
+            rest[done, last] = best or 0
+    return rest
+
+
+class _Paths:
+    """Least distance between places along the distance table (which need not obey the
+    triangle inequality), times a robot's travel factor."""
+
+    def __init__(self, problem: Problem):
+        self.problem = problem
+        places = problem.locations()
+        self.index = {p: k for k, p in enumerate(places)}
+        far = [[problem.distances.get((a, b), Fraction(0) if a == b else None)
+                for b in places] for a in places]
+        for via in range(len(places)):
+            row_via = far[via]
+            for i in range(len(places)):
+                to_via = far[i][via]
+                if to_via is None:
+                    continue
+                row = far[i]
+                for j in range(len(places)):
+                    onward = row_via[j]
+                    if onward is not None and (row[j] is None or to_via + onward < row[j]):
+                        row[j] = to_via + onward
+        self.paths = far
+
+    def travel(self, robot, first, second) -> Fraction:
+        """`first`, `second`: job names."""
+        problem = self.problem
+        if problem.locomote is None:
+            return Fraction(0)
+        r = problem.robot(robot)
+        distance = self.paths[self.index[problem.job(first).location]][
+            self.index[problem.job(second).location]]
+        return ((distance or Fraction(0)) * problem.robot_types[r.type][problem.locomote]
+                / r.speed)
