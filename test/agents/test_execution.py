@@ -341,6 +341,27 @@ def test_continued_job_that_is_not_first_is_not_continued():
     assert attempts(r.step(3.1)) == [(DONE, 'J0', 1), (ARRIVED, 'J1', 2), (STARTED, 'J1', 2)]
 
 
+def test_continued_job_starts_no_earlier_than_a_predecessor_done_before_the_revision():
+    """A waits at J2 from 2 for J1 (B's, due to end at 2 and reported done at 2.000002, its
+    end rounded up onto the report grid). Revision 2, planned once J1 was done, leaves J1
+    out but still names it a predecessor of J2, which goes on: J2 starts when J1 ended, not
+    when A arrived (a planner restarted mid-mission found the start 2 before 2.000002)."""
+    r = RobotExecution('A')
+    plan(r, 1, [task('J2', 2, 5, preds=['J1'])], {'J1': {'B'}, 'J2': {'A'}})
+    assert kinds(r.step(2)) == [(ARRIVED, 'J2', 2)]
+    r.operation_done('B', 'J1', 2.000002, 1)
+    plan(r, 2, [task('J2', 3, 5, preds=['J1'])], {'J2': {'A'}}, now=3, continued={'J2'})
+    assert [(e.kind, e.job, e.time) for e in r.step(3)] == [(STARTED, 'J2', 2.000002)]
+
+
+def test_a_predecessor_done_before_the_revision_and_never_heard_of_does_not_hold_a_job():
+    """An agent started after J1 was declared done knows no report of it: the revision
+    leaves J1 out, so it is complete, and J2 starts when its robots are there."""
+    r = RobotExecution('A')
+    plan(r, 2, [task('J2', 3, 5, preds=['J1'])], {'J2': {'A'}}, now=3)
+    assert kinds(r.step(3)) == [(ARRIVED, 'J2', 3), (STARTED, 'J2', 3)]
+
+
 def test_robot_finishes_its_leg_before_following_the_new_sequence():
     r = RobotExecution('A')
     plan(r, 1, [task('J1', 0, 1), task('J2', 5, 1, leg=4)])

@@ -491,7 +491,10 @@ class RobotExecution:
         return (self.robot, job) in self._operation_done or job in self._job_done
 
     def _start_time(self, task: Task) -> float | None:
-        """When the job can start: its last robot arrived and last predecessor completed."""
+        """When the job can start: its last robot arrived and last predecessor completed.
+        A predecessor the revision leaves out was complete when it was planned: what was
+        reported of its end counts (a job that goes on from an older revision may have
+        robots there since before it ended), and if nothing was, it holds nothing up."""
         times = []
         for robot in self._job_robots.get(task.job, frozenset({self.robot})) | {self.robot}:
             if (robot, task.job) not in self._arrived:
@@ -499,6 +502,11 @@ class RobotExecution:
             times.append(self._arrived[robot, task.job].time)
         for job in task.predecessors:
             end = self._job_end(job)
+            if end is None and job not in self._job_robots:
+                end = max((fact.time for (_, done), fact in self._operation_done.items()
+                           if done == job), default=None)
+                if end is None:
+                    continue
             if end is None:
                 return None
             times.append(end)

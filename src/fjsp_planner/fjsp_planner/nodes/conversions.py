@@ -39,7 +39,7 @@ def plan_msg(scenario: Problem, posed: Problem, schedule: Schedule, result: Resu
                 operation_end=float(a.start + posed.duration(robot.name, q)),
                 end=float(a.end),
                 co_workers=sorted(r for r in a.robots if r != robot.name),
-                predecessors=posed.predecessors(visit.job),
+                predecessors=_predecessors(scenario, posed, visit.job),
                 held_into_next=following is not None
                 and holds.get((visit.job, q)) == following,
                 continued=visit.job in continued))
@@ -50,6 +50,13 @@ def plan_msg(scenario: Problem, posed: Problem, schedule: Schedule, result: Resu
                 mission_start=mission_start, time_scale=time_scale,
                 makespan=float(result.makespan), solver_status=str(result.status),
                 lower_bound=_float(result.lower_bound), robots=robots)
+
+
+def _predecessors(scenario: Problem, posed: Problem, job: str) -> list[str]:
+    """Every job that must complete before `job`, those done before a re-plan included: a
+    job that goes on from an older revision may have its robots there since before the
+    last of them ended, and must not start before it."""
+    return list(dict.fromkeys(scenario.predecessors(job) + posed.predecessors(job)))
 
 
 def cancel_msg(scenario: Problem, mission_id: str, revision: int, mission_start,

@@ -1,0 +1,28 @@
+"""What a revision's plan message tells the agents, built from the domain core's objects."""
+
+import dataclasses
+from pathlib import Path
+
+from fjsp_planner.core.scenario import load_scenario
+from fjsp_planner.core.solve import solve
+from fjsp_planner.nodes.conversions import plan_msg
+
+SCENARIO = Path(__file__).resolve().parents[2] / 'config' / 'scenarios' / 'solar_panel.yaml'
+
+
+def test_a_revision_names_the_predecessors_done_before_it():
+    """A re-plan once LSMS has moved M1 and M2 poses the rest without them; `Ja` may go on
+    with its robots there since before M2 ended, so its task still names both: the agents
+    start it no earlier than M2's reported end (a restarted planner's revision left M2 out
+    and they started `Ja` at 2, before M2's end at 2.000002)."""
+    scenario = load_scenario(SCENARIO)
+    done = {'M1', 'M2'}
+    posed = dataclasses.replace(
+        scenario, jobs=tuple(j for j in scenario.jobs if j.name not in done),
+        precedence=tuple((a, b) for a, b in scenario.precedence if a not in done))
+    result = solve(posed, time_limit=2, workers=1)
+    msg = plan_msg(scenario, posed, result.schedule, result, 'mission', 2, 0.0, 1.0, None)
+    tasks = [t for robot in msg.robots for t in robot.tasks]
+    assert {t.job for t in tasks} == {j.name for j in posed.jobs}
+    assert all(sorted(t.predecessors) == ['M1', 'M2'] for t in tasks if t.job in ('Ja', 'Jb'))
+    assert all(list(t.predecessors) == ['Ja'] for t in tasks if t.job == 'Aa')
