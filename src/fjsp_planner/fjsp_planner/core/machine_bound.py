@@ -94,10 +94,10 @@ def panel_machine_bound(problem: Problem, incumbent: Fraction, time_limit: float
     for kind, (count, allowed) in enumerate(kinds):
         if count == 0:
             continue
-        shape = _panel_shape(problem, allowed, group, set(limits))
+        shape = panel_shape(problem, allowed, group, set(limits))
         if shape is None:
             return None
-        panel_jobs, panel_lags, panel_holds = _within(shape, incumbent, every_job)
+        panel_jobs, panel_lags, panel_holds = within_incumbent(shape, incumbent, every_job)
         for _ in range(count):
             kind_of.append(kind)
             jobs += [(len(kind_of) - 1, *job) for job in panel_jobs]
@@ -112,7 +112,7 @@ def panel_machine_bound(problem: Problem, incumbent: Fraction, time_limit: float
     return _solve(jobs, lags, holds, kind_of, travel, time_limit, workers, subsolvers)
 
 
-def _within(shape, incumbent, every_job):
+def within_incumbent(shape, incumbent, every_job):
     """The shape without the choices that make a job end at or after `incumbent` whatever
     else happens (no schedule shorter than it uses them), a job keeping at least its
     fastest; unless `every_job`, jobs left with no heavy choice and no limited robot are
@@ -129,7 +129,7 @@ def _within(shape, incumbent, every_job):
             {(a, b) for a, b in holds if a in names and b in names})
 
 
-def _panel_shape(problem: Problem, allowed, group, limited):
+def panel_shape(problem: Problem, allowed, group, limited):
     """For one panel staffed from `allowed`: its jobs as (name, head, tail, choices), the lags
     between them and the holding pairs, or None if some job cannot be staffed."""
     durations, choices, staffed = {}, {}, {}

@@ -10,7 +10,7 @@ no staffing that is neither heavy nor has a limited robot (the others can always
 few robots of G and are forgotten), and orders them all by their start times. A job then
 starts no earlier than:
 
-- its head (the least time precedence chains need before it, `machine_bound._panel_shape`);
+- its head (the least time precedence chains need before it, `machine_bound.panel_shape`);
 - when heavy, the end of the heavy job before it plus the least travel of the slowest robot
   both share, along the places of the panels *where they lie* (the paper's panels lie in a
   row: from the fifth back to the second is three crossings), or the lag a precedence chain
@@ -46,7 +46,7 @@ import time
 from fractions import Fraction
 
 from fjsp_planner.core.bounds import panel_limits
-from fjsp_planner.core.machine_bound import _panel_shape, _within
+from fjsp_planner.core.machine_bound import panel_shape, within_incumbent
 from fjsp_planner.core.problem import Problem
 
 MAX_PANELS = 6
@@ -90,10 +90,10 @@ def panel_sequence_bound(problem: Problem, incumbent: Fraction, time_limit: floa
 def _kept_jobs(problem, allowed, group, limited, incumbent):
     """(jobs, lags, holds) of one panel staffed from `allowed`, keeping the jobs each choice
     of which is heavy or has a limited robot, or None if some job cannot be staffed."""
-    shape = _panel_shape(problem, allowed, group, limited)
+    shape = panel_shape(problem, allowed, group, limited)
     if shape is None:
         return None
-    jobs, lags, holds = _within(shape, incumbent, every_job=True)
+    jobs, lags, holds = within_incumbent(shape, incumbent, every_job=True)
     kept = [job for job in jobs if all(c.heavy or c.limited for c in job[3])]
     names = {job[0] for job in kept}
     return (kept, {key: lag for key, lag in lags.items() if set(key) <= names},
@@ -184,21 +184,20 @@ class _Search:
 
     def _eager(self, shape, k, j, choice, last, where, recent) -> bool:
         """Whether job j of panel k, staffed lightly by `choice` (so with a limited robot),
-        may come now: right after what must come before it, the job before it on a limited
-        robot of the choice or a job it follows by precedence. Every order of a schedule
-        can be rearranged so, its light jobs each moved up to right after the last of those
-        (which only drops constraints of the order), so the search keeps no other orders
-        and loses nothing."""
-        if recent is None:
-            if last is None:
-                return not shape.before[j] and all(w is None for w in where)
-            p, i, _ = last
-            recent = (p, i)
-        q, m = recent
-        if q == k and shape.before[j] >> m & 1:
+        may come now: right after what must come before it (the job before it on a limited
+        robot of the choice, or a job it follows by precedence), or after another light job
+        (several placed after the same job go in any order). Every order of a schedule can
+        be rearranged so, its light jobs each moved up to right after the last of those,
+        which keeps each robot's order and every precedence, so the search keeps no other
+        orders and loses nothing."""
+        if recent is not None:
             return True
-        return any(where[n] == recent for n, robot in enumerate(self.limited)
-                   if robot in choice.limited)
+        if last is None:
+            return not shape.before[j] and all(w is None for w in where)
+        p, i, _ = last
+        return (p == k and shape.before[j] >> i & 1) or any(
+            where[n] == (p, i) for n, robot in enumerate(self.limited)
+            if robot in choice.limited)
 
     def run(self, layouts, deadline) -> Fraction:
         """The least makespan of the relaxation over `layouts` (per panel, its shape), or the
