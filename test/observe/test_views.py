@@ -62,6 +62,18 @@ def test_a_waiting_robot_says_what_it_waits_for():
     assert b['detail'] == 'J2: waits for A to arrive, J1 to be done, planned start t=4.0'
 
 
+def test_a_predecessor_done_before_the_revision_is_not_waited_for():
+    # A monitor started after J1 ended never saw it done; revision 2 leaves it out, as
+    # the planner leaves out every job done before a revision, and still names it.
+    facts = [plan(2, 0, [task('A', 'J2', 4, 6, co_workers=['B'], predecessors=['J1']),
+                         task('B', 'J2', 4, 6, co_workers=['A'], predecessors=['J1'])])]
+    facts += [event(EventKind.ARRIVED, 'B', 'J2', 2, 3),
+              state('B', 3.5, mode=RobotMode.WAITING, job='J2', location='at_J2', revision=2)]
+    fleet = fleet_of(facts)
+    b = row_of(views.robot_rows(fleet, fleet.missions[MISSION], at(3.6)), 'B')
+    assert b['detail'] == 'J2: waits for A to arrive, planned start t=4.0'
+
+
 def test_a_holding_robot_says_whom_it_waits_for_to_finish():
     facts = [plan(1, 0, [task('A', 'J1', 1, 3, co_workers=['B']),
                          task('B', 'J1', 1, 5, co_workers=['A'])])]

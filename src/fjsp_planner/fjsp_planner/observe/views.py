@@ -118,10 +118,13 @@ def _detail(mission: MissionHistory, state, mode: RobotMode) -> str:
                 else f'{job}: finishing{holding}')
     arrived = _arrived(mission, job, state.revision)
     done = {j for j, a in mission.latest_attempts().items() if a.outcome == Outcome.DONE}
+    # A revision leaves out the jobs done before it but still names them as predecessors;
+    # the monitor may not have seen them done (it started later).
+    planned = {t.job for t in mission.plans[state.revision].tasks}
     waits = [f'{r} to arrive' for r in mine.co_workers if r not in arrived]
-    waits += [f'{j} to be done' for j in mine.predecessors if j not in done]
-    planned = f', planned start t={mine.start:.1f}'
-    return (f'{job}: waits for {", ".join(waits)}{planned}{holding}' if waits
+    waits += [f'{j} to be done' for j in mine.predecessors if j in planned and j not in done]
+    start = f', planned start t={mine.start:.1f}'
+    return (f'{job}: waits for {", ".join(waits)}{start}{holding}' if waits
             else f'{job}: starting{holding}')
 
 
