@@ -162,6 +162,27 @@ def test_sequence_bound_on_the_paper_three_panels():
     assert panel_sequence_bound(problem, Fraction(919, 6), 30) == Fraction(424, 3)
 
 
+@pytest.mark.parametrize('slow_hold', [1, 6])
+def test_sequence_bound_lets_a_job_overlap_a_limited_robots_job_it_does_not_follow(slow_hold):
+    """Per panel X (hold and weld) and Y (two welds), unrelated; S holds in 1 or 6 but takes
+    200 to cross, arms hold in 3 and weld in 1, panels 1 apart. Jobs with two of the three
+    arms run one after another; X with S and one arm need not. The optimum, 6 either way:
+    S and A1 do the first panel's X while A2 and A3 do its Y (0-1), then the other panel's
+    X by two arms (2-5) and Y (5-6). The search once claimed 7 on both: it counted a switch
+    into the first panel it entered (S holding in 1), and it started the first Y no earlier
+    than the end of S's X though nothing orders them (S holding in 6)."""
+    types = {'Slow': {0: Fraction(slow_hold), 1: Fraction(100), 2: Fraction(200)},
+             'Arm': {0: Fraction(3), 1: Fraction(1), 2: Fraction(1)}}
+    robots = (Robot('S', 'Slow'), Robot('A1', 'Arm'), Robot('A2', 'Arm'), Robot('A3', 'Arm'))
+    panel = Problem(operation_types={0: 'hold', 1: 'weld', 2: 'move'}, robot_types=types,
+                    robots=robots, jobs=(Job('X', 'a', ((0, 1),)), Job('Y', 'a', ((1, 1),))),
+                    distances={}, locomote=2, name='unrelated')
+    problem = repeat_panels(panel, 2, 1)
+    exact = solve(problem, time_limit=20)
+    assert exact.status == Status.OPTIMAL and exact.makespan == 6
+    assert panel_sequence_bound(problem, Fraction(7), 10) == 6
+
+
 def test_sequence_bound_stays_out_of_many_panels():
     """Its states grow as the product of the panels' progress; the load bound speaks for
     more panels."""

@@ -28,8 +28,8 @@ tail), over every choice of the panels the limited robots may work in: a best-fi
 over (the panels they may work in, which jobs of each panel are done, the last heavy one and
 each limited robot's last one), with an estimate of what is left that never overstates it
 (the least durations of the jobs only heavy staffings can do, the lags or switches between
-them and one switch into each panel left, a switch costing at least its travel and how much
-longer the job after it takes than its least).
+them and one switch into each panel left but the first one entered, a switch costing at
+least its travel and how much longer the job after it takes than its least).
 
 It forgets lags between jobs whose ends it does not keep, the routes of robots of G between
 jobs that are not consecutive heavy ones, and which robot of a set does what. Every schedule
@@ -220,7 +220,9 @@ class _Search:
                 else:
                     left += shape.rest[done, -1]
                     others += 1
-            return left + others * switch + (tail or 0)
+            if last_panel is None:
+                others -= 1  # the first heavy job is entered from no panel
+            return left + max(others, 0) * switch + (tail or 0)
 
         counter = itertools.count()
         frontier = []
@@ -289,8 +291,8 @@ class _Search:
                             if limited[n] in choice.limited:
                                 begin = max(begin, ends[n] + travel[
                                     limited[n], q, shapes[q].names[m], k, shape.names[j]])
-                            if q == k:
-                                begin = max(begin, ends[n] + shape.lags.get((m, j), 0))
+                            if q == k and (m, j) in shape.lags:
+                                begin = max(begin, ends[n] + shape.lags[m, j])
                         end = begin + choice.duration
                         new_ends = list(ends)
                         for n in robots:
