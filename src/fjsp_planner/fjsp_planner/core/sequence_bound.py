@@ -21,15 +21,19 @@ starts no earlier than:
 
 A jig job staffed heavily whose robots all hold into another job is directly followed by it
 among the heavy ones (its robots are busy until the held job ends, and any other heavy job
-shares one of them). At most the sum of the limits of panels have jobs a limited robot works
-on; the others are staffed from G. Its value is the least makespan over such orders, each
-job at its least duration for the robots chosen plus the least time after its end (its
-tail), over every choice of the panels the limited robots may work in: a best-first search
-over (the panels they may work in, which jobs of each panel are done, the last heavy one and
-each limited robot's last one), with an estimate of what is left that never overstates it
-(the least durations of the jobs only heavy staffings can do, the lags or switches between
-them and one switch into each panel left but the first one entered, a switch costing at
-least its travel and how much longer the job after it takes than its least).
+shares one of them). One staffed lightly, that no other job follows, is placed right before
+the job it holds into, which keeps its robots: they are busy from its start to the held
+job's end, so a job placed before it sharing one of them ended before it began, and its
+limited robot does nothing in between. At most the sum of the limits of panels have jobs a
+limited robot works on; the others are staffed from G. Its value is the least makespan over
+such orders, each job at its least duration for the robots chosen plus the least time after
+its end (its tail), over every choice of the panels the limited robots may work in: a
+best-first search over (the panels they may work in, which jobs of each panel are done, the
+last heavy one and each limited robot's last one), with an estimate of what is left that
+never overstates it (the least durations of the jobs only heavy staffings can do, the lags
+or switches between them and one switch into each panel left but the first one entered, a
+switch costing at least its travel and how much longer the job after it takes than its
+least).
 
 It forgets lags between jobs whose ends it does not keep, the routes of robots of G between
 jobs that are not consecutive heavy ones, and which robot of a set does what. Every schedule
@@ -126,6 +130,10 @@ class _Search:
 
         self.travel = {key: ticks(v) for key, v in travel.items()}
         self.bare, self.helped = _Shape(bare, ticks), _Shape(helped, ticks)
+        arcs = list(problem.precedence) + [(a, b) for a, b, _ in problem.holding]
+        for shape in (self.bare, self.helped):
+            shape.jig_into = {i: h for i, h in shape.held.items() if {
+                b for a, b in arcs if a == shape.names[i]} == {shape.names[h]}}
         self.incumbent = ticks(incumbent)
         self.switch = self._least_switch()
         for shape in (self.bare, self.helped):
@@ -203,43 +211,25 @@ class _Search:
         """The least makespan of the relaxation over `layouts` (per panel, its shape), or the
         least value still open when the deadline comes (a lower bound either way); the
         incumbent when no order ends before it."""
-        limited, switch, travel = self.limited, self.switch, self.travel
-        robots = range(len(limited))
-
-        def estimate(shapes, progress, last_panel, last_job):
-            left, tail, others = 0, None, 0
-            for k, shape in enumerate(shapes):
-                done = progress[k]
-                if done & shape.heavy_mask == shape.heavy_mask:
-                    continue
-                left += shape.left[done]
-                tail = shape.least_tail[done] if tail is None else min(
-                    tail, shape.least_tail[done])
-                if k == last_panel:
-                    left += shape.rest[done, last_job]
-                else:
-                    left += shape.rest[done, -1]
-                    others += 1
-            if last_panel is None:
-                others -= 1  # the first heavy job is entered from no panel
-            return left + max(others, 0) * switch + (tail or 0)
-
-        counter = itertools.count()
-        frontier = []
+        self.layouts_ = layouts
+        self.counter = itertools.count()
+        self.frontier = []
+        self.gaps = {}
+        nobody = tuple(None for _ in self.limited)
         for layout, shapes in enumerate(layouts):
             progress = tuple(0 for _ in shapes)
-            state = (layout, progress, None, tuple(None for _ in robots), None)
-            frontier.append((estimate(shapes, progress, None, -1), next(counter), state, 0, 0,
-                             tuple(0 for _ in robots)))
-        heapq.heapify(frontier)
-        closed, gaps = {}, {}
+            state = (layout, progress, None, nobody, None)
+            self.frontier.append((self._estimate(shapes, progress, None, -1),
+                                  next(self.counter), state, 0, 0, tuple(0 for _ in nobody)))
+        heapq.heapify(self.frontier)
+        closed = {}
         expansions = 0
-        while frontier:
+        while self.frontier:
             expansions += 1
             if expansions % 512 == 0 and (time.monotonic() > deadline
-                                          or len(frontier) > MAX_OPEN):
-                return Fraction(frontier[0][0], self.scale)
-            value, _, state, now, latest, ends = heapq.heappop(frontier)
+                                          or len(self.frontier) > MAX_OPEN):
+                return Fraction(self.frontier[0][0], self.scale)
+            value, _, state, now, latest, ends = heapq.heappop(self.frontier)
             layout, progress, last, where, recent = state
             shapes = layouts[layout]
             if all(done == shape.full for done, shape in zip(progress, shapes, strict=True)):
@@ -249,6 +239,7 @@ class _Search:
                    for t, m, e in labels):
                 continue
             labels.append((now, latest, ends))
+            node = (state, now, latest, ends)
             forced = None
             if last is not None:
                 p, i, last_choice = last
@@ -260,61 +251,128 @@ class _Search:
                 for j in range(len(shape.names)):
                     if done >> j & 1 or shape.before[j] & ~done:
                         continue
-                    after = progress[:k] + (done | 1 << j,) + progress[k + 1:]
-                    rest = None
+                    jig_into = shape.jig_into.get(j)
                     for choice in shape.choices[j]:
-                        begin = shape.heads[j]
-                        if choice.heavy:
-                            if forced is not None and (forced != (k, j) or not any(
-                                    a <= b for a in last_choice.sets for b in choice.sets)):
-                                continue
-                            if last is not None:
-                                key = (p, i, last_choice, k, j, choice)
-                                gap = gaps.get(key)
-                                if gap is None:
-                                    gap = self.gap(p, last_choice, shapes[p].names[i], k,
-                                                   choice, shape.names[j])
-                                    if p == k:
-                                        gap = max(gap, shape.lags.get((i, j), 0))
-                                    gaps[key] = gap
-                                begin = max(begin, now + gap)
-                        else:
-                            if not self._eager(shape, k, j, choice, last, where, recent):
-                                continue
-                            if last is not None and p == k:
-                                begin = max(begin, now + shape.lags.get((i, j), 0))
-                        moved = list(where)
-                        for n in robots:
-                            if where[n] is None:
-                                continue
-                            q, m = where[n]
-                            if limited[n] in choice.limited:
-                                begin = max(begin, ends[n] + travel[
-                                    limited[n], q, shapes[q].names[m], k, shape.names[j]])
-                            if q == k and (m, j) in shape.lags:
-                                begin = max(begin, ends[n] + shape.lags[m, j])
-                        end = begin + choice.duration
-                        new_ends = list(ends)
-                        for n in robots:
-                            if limited[n] in choice.limited:
-                                new_ends[n], moved[n] = end, (k, j)
-                        new_latest = max(latest, end + shape.tails[j])
-                        if choice.heavy:
-                            new_now, new_last, new_recent = end, (k, j, choice), None
-                            if rest is None:
-                                rest = estimate(shapes, after, k, j)
-                            bound = max(new_latest, end + rest)
-                        else:
-                            new_now, new_last, new_recent = now, last, (k, j)
-                            bound = max(new_latest, now + estimate(
-                                shapes, after, p if last else None, i if last else -1))
-                        if bound >= self.incumbent:
+                        if jig_into is not None and not choice.heavy:
+                            self._place_jig(node, k, j, choice, jig_into, forced)
                             continue
-                        heapq.heappush(frontier, (
-                            bound, next(counter),
-                            (layout, after, new_last, tuple(moved), new_recent),
-                            new_now, new_latest, tuple(new_ends)))
+                        if choice.heavy and forced is not None and (
+                                forced != (k, j) or not any(
+                                    a <= b for a in last_choice.sets for b in choice.sets)):
+                            continue
+                        if not choice.heavy and not self._eager(shape, k, j, choice, last,
+                                                                 where, recent):
+                            continue
+                        begin = self._after_last(node, k, j, choice, eager=True)
+                        self._place(node, k, j, choice, begin)
         return Fraction(self.incumbent, self.scale)
+
+    def _after_last(self, node, k, j, choice, eager):
+        """Earliest start of job j of panel k staffed by `choice` after the last heavy job
+        and each limited robot's last job: a heavy one starts the gap after the last heavy
+        job; a light one placed right after the jobs it must follow (`eager`) no earlier
+        than the end of a last heavy job of its panel (which it follows, or follows a job
+        that does), one placed elsewhere only after a last heavy job it shares a robot with
+        or follows."""
+        (layout, _, last, where, _), now, _, ends = node
+        shapes = self.layouts_[layout]
+        shape = shapes[k]
+        begin = shape.heads[j]
+        if last is not None:
+            p, i, last_choice = last
+            if choice.heavy or not eager and all(
+                    x & y for x in last_choice.sets for y in choice.sets):
+                key = (p, i, last_choice, k, j, choice)
+                gap = self.gaps.get(key)
+                if gap is None:
+                    gap = self.gap(p, last_choice, shapes[p].names[i], k, choice,
+                                   shape.names[j])
+                    self.gaps[key] = gap
+                begin = max(begin, now + gap)
+            if p == k and (eager and not choice.heavy or (i, j) in shape.lags):
+                begin = max(begin, now + shape.lags.get((i, j), 0))
+        for n, robot in enumerate(self.limited):
+            if where[n] is None:
+                continue
+            q, m = where[n]
+            if robot in choice.limited:
+                begin = max(begin, ends[n] + self.travel[robot, q, shapes[q].names[m], k,
+                                                         shape.names[j]])
+            if q == k and (m, j) in shape.lags:
+                begin = max(begin, ends[n] + shape.lags[m, j])
+        return begin
+
+    def _place_jig(self, node, k, j, choice, held, forced):
+        """Job j, a jig job staffed lightly whose robots all hold into job `held` and which
+        nothing else follows, placed right before `held` (each staffing of it that keeps
+        them): its robots are busy from its start to the held job's end, so a job placed
+        before sharing a robot with it ended before it began, and its light staffing then
+        needs no place of its own in the order."""
+        (layout, progress, last, where, recent), now, latest, ends = node
+        shape = self.layouts_[layout][k]
+        if shape.before[held] & ~(progress[k] | 1 << j):
+            return
+        end = self._after_last(node, k, j, choice, eager=False) + choice.duration
+        moved, new_ends = list(where), list(ends)
+        for n, robot in enumerate(self.limited):
+            if robot in choice.limited:
+                moved[n], new_ends[n] = (k, j), end
+        after = progress[:k] + (progress[k] | 1 << j,) + progress[k + 1:]
+        inner = ((layout, after, last, tuple(moved), recent), now,
+                 max(latest, end + shape.tails[j]), tuple(new_ends))
+        for second in shape.choices[held]:
+            if not any(a <= b for a in choice.sets for b in second.sets) or (
+                    second.heavy and forced is not None and forced != (k, held)):
+                continue
+            begin = max(self._after_last(inner, k, held, second, eager=False),
+                        end + shape.lags.get((j, held), 0))
+            self._place(inner, k, held, second, begin)
+
+    def _place(self, node, k, j, choice, begin):
+        """Push the order `node` continued by job j of panel k staffed by `choice` from
+        `begin`, unless it cannot end before the incumbent."""
+        (layout, progress, last, where, recent), now, latest, ends = node
+        shapes = self.layouts_[layout]
+        shape = shapes[k]
+        after = progress[:k] + (progress[k] | 1 << j,) + progress[k + 1:]
+        end = begin + choice.duration
+        moved, new_ends = list(where), list(ends)
+        for n, robot in enumerate(self.limited):
+            if robot in choice.limited:
+                moved[n], new_ends[n] = (k, j), end
+        new_latest = max(latest, end + shape.tails[j])
+        if choice.heavy:
+            new_now, new_last, new_recent = end, (k, j, choice), None
+            bound = max(new_latest, end + self._estimate(shapes, after, k, j))
+        else:
+            new_now, new_last, new_recent = now, last, (k, j)
+            bound = max(new_latest, now + self._estimate(
+                shapes, after, last[0] if last else None, last[1] if last else -1))
+        if bound < self.incumbent:
+            heapq.heappush(self.frontier, (
+                bound, next(self.counter),
+                (layout, after, new_last, tuple(moved), new_recent),
+                new_now, new_latest, tuple(new_ends)))
+
+    def _estimate(self, shapes, progress, last_panel, last_job):
+        """What is left after the last heavy job (job `last_job` of panel `last_panel`, or
+        none): the module docstring's estimate."""
+        left, tail, others = 0, None, 0
+        for k, shape in enumerate(shapes):
+            done = progress[k]
+            if done & shape.heavy_mask == shape.heavy_mask:
+                continue
+            left += shape.left[done]
+            tail = shape.least_tail[done] if tail is None else min(
+                tail, shape.least_tail[done])
+            if k == last_panel:
+                left += shape.rest[done, last_job]
+            else:
+                left += shape.rest[done, -1]
+                others += 1
+        if last_panel is None:
+            others -= 1  # the first heavy job is entered from no panel
+        return left + max(others, 0) * self.switch + (tail or 0)
 
 
 class _Shape:

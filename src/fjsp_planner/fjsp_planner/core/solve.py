@@ -37,7 +37,7 @@ MACHINE_SHARE = 0.1
 paper are solved to its optimum in about 3 s; beyond, it returns what it proved in time.
 The panel sequence bound (`sequence_bound`) has at most half of it, and the machine bound the
 other half when it does not keep every job (above `machine_bound.EVERY_JOB_LIMIT`): from 3
-panels of the paper on the sequence bound proves more (3 panels: 141 1/3 in 0.2 s, where the
+panels of the paper on the sequence bound proves more (3 panels: 146 1/3 in 0.3 s, where the
 machine bound reaches about 126 in 6 s); on 2 it ends at once."""
 LOAD_SHARE = 0.05
 """Share of the time limit for the panel load bound (`load_bound`): it proves the loads alone
