@@ -211,7 +211,7 @@ class _Search:
         """The least makespan of the relaxation over `layouts` (per panel, its shape), or the
         least value still open when the deadline comes (a lower bound either way); the
         incumbent when no order ends before it."""
-        self.layouts_ = layouts
+        self.layout_shapes = layouts
         self.counter = itertools.count()
         self.frontier = []
         self.gaps = {}
@@ -219,7 +219,7 @@ class _Search:
         for layout, shapes in enumerate(layouts):
             progress = tuple(0 for _ in shapes)
             state = (layout, progress, None, nobody, None)
-            self.frontier.append((self._estimate(shapes, progress, None, -1),
+            self.frontier.append((self._estimate_anew(shapes, progress, None, -1),
                                   next(self.counter), state, 0, 0, tuple(0 for _ in nobody)))
         heapq.heapify(self.frontier)
         closed = {}
@@ -240,6 +240,7 @@ class _Search:
                 continue
             labels.append((now, latest, ends))
             node = (state, now, latest, ends)
+            self.estimates = {}
             forced = None
             if last is not None:
                 p, i, last_choice = last
@@ -275,7 +276,7 @@ class _Search:
         that does), one placed elsewhere only after a last heavy job it shares a robot with
         or follows."""
         (layout, _, last, where, _), now, _, ends = node
-        shapes = self.layouts_[layout]
+        shapes = self.layout_shapes[layout]
         shape = shapes[k]
         begin = shape.heads[j]
         if last is not None:
@@ -309,17 +310,14 @@ class _Search:
         before sharing a robot with it ended before it began, and its light staffing then
         needs no place of its own in the order."""
         (layout, progress, last, where, recent), now, latest, ends = node
-        shape = self.layouts_[layout][k]
+        shape = self.layout_shapes[layout][k]
         if shape.before[held] & ~(progress[k] | 1 << j):
             return
         end = self._after_last(node, k, j, choice, eager=False) + choice.duration
-        moved, new_ends = list(where), list(ends)
-        for n, robot in enumerate(self.limited):
-            if robot in choice.limited:
-                moved[n], new_ends[n] = (k, j), end
+        moved, new_ends = self._limited_at(where, ends, choice, k, j, end)
         after = progress[:k] + (progress[k] | 1 << j,) + progress[k + 1:]
-        inner = ((layout, after, last, tuple(moved), recent), now,
-                 max(latest, end + shape.tails[j]), tuple(new_ends))
+        inner = ((layout, after, last, moved, recent), now,
+                 max(latest, end + shape.tails[j]), new_ends)
         for second in shape.choices[held]:
             if not any(a <= b for a in choice.sets for b in second.sets) or (
                     second.heavy and forced is not None and forced != (k, held)):
@@ -332,31 +330,45 @@ class _Search:
         """Push the order `node` continued by job j of panel k staffed by `choice` from
         `begin`, unless it cannot end before the incumbent."""
         (layout, progress, last, where, recent), now, latest, ends = node
-        shapes = self.layouts_[layout]
+        shapes = self.layout_shapes[layout]
         shape = shapes[k]
         after = progress[:k] + (progress[k] | 1 << j,) + progress[k + 1:]
         end = begin + choice.duration
+        moved, new_ends = self._limited_at(where, ends, choice, k, j, end)
+        new_latest = max(latest, end + shape.tails[j])
+        if choice.heavy:
+            new_now, new_last, new_recent = end, (k, j, choice), None
+            bound = max(new_latest, end + self._estimate(layout, after, k, j))
+        else:
+            new_now, new_last, new_recent = now, last, (k, j)
+            bound = max(new_latest, now + self._estimate(
+                layout, after, last[0] if last else None, last[1] if last else -1))
+        if bound < self.incumbent:
+            heapq.heappush(self.frontier, (
+                bound, next(self.counter), (layout, after, new_last, moved, new_recent),
+                new_now, new_latest, new_ends))
+
+    def _limited_at(self, where, ends, choice, k, j, end):
+        """(each limited robot's last job, its end) once job j of panel k, staffed by
+        `choice`, ends at `end`."""
         moved, new_ends = list(where), list(ends)
         for n, robot in enumerate(self.limited):
             if robot in choice.limited:
                 moved[n], new_ends[n] = (k, j), end
-        new_latest = max(latest, end + shape.tails[j])
-        if choice.heavy:
-            new_now, new_last, new_recent = end, (k, j, choice), None
-            bound = max(new_latest, end + self._estimate(shapes, after, k, j))
-        else:
-            new_now, new_last, new_recent = now, last, (k, j)
-            bound = max(new_latest, now + self._estimate(
-                shapes, after, last[0] if last else None, last[1] if last else -1))
-        if bound < self.incumbent:
-            heapq.heappush(self.frontier, (
-                bound, next(self.counter),
-                (layout, after, new_last, tuple(moved), new_recent),
-                new_now, new_latest, tuple(new_ends)))
+        return tuple(moved), tuple(new_ends)
 
-    def _estimate(self, shapes, progress, last_panel, last_job):
+    def _estimate(self, layout, progress, last_panel, last_job):
         """What is left after the last heavy job (job `last_job` of panel `last_panel`, or
-        none): the module docstring's estimate."""
+        none): the module docstring's estimate, kept while one order is continued (its
+        staffings of one job share it)."""
+        key = (layout, progress, last_panel, last_job)
+        found = self.estimates.get(key)
+        if found is None:
+            found = self.estimates[key] = self._estimate_anew(
+                self.layout_shapes[layout], progress, last_panel, last_job)
+        return found
+
+    def _estimate_anew(self, shapes, progress, last_panel, last_job):
         left, tail, others = 0, None, 0
         for k, shape in enumerate(shapes):
             done = progress[k]
