@@ -24,16 +24,22 @@ among the heavy ones (its robots are busy until the held job ends, and any other
 shares one of them). One staffed lightly, that no other job follows, is placed right before
 the job it holds into, which keeps its robots: they are busy from its start to the held
 job's end, so a job placed before it sharing one of them ended before it began, and its
-limited robot does nothing in between. At most the sum of the limits of panels have jobs a
-limited robot works on; the others are staffed from G. Its value is the least makespan over
-such orders, each job at its least duration for the robots chosen plus the least time after
-its end (its tail), over every choice of the panels the limited robots may work in: a
-best-first search over (the panels they may work in, which jobs of each panel are done, the
-last heavy one and each limited robot's last one), with an estimate of what is left that
-never overstates it (the least durations of the jobs only heavy staffings can do, the lags
-or switches between them and one switch into each panel left but the first one entered, a
-switch costing at least its travel and how much longer the job after it takes than its
-least).
+limited robot does nothing in between.
+
+Every schedule has a set of panels where limited robots work on kept jobs, at most the sum
+of their limits; in the other panels the kept jobs are staffed from G. The search takes each
+such set on its own (its *layout*): a limited robot works in each of its panels, so an order
+in which one has not yet is no shorter than the least way of a limited robot from its last
+job to a job left there and that job's tail (for two such panels, of one robot through both
+or two robots; panels a robot cannot reach in time rule the layout out), and an order that
+does every job of such a panel without one belongs to another layout. Its value is the least
+makespan over such orders, each job at its least duration for the robots chosen plus the
+least time after its end (its tail), over every layout: a best-first search over (the
+layout, which jobs of each panel are done, the last heavy one, each limited robot's last one
+and the panels they have worked in), with an estimate of what is left that never overstates
+it (the least durations of the jobs only heavy staffings can do, the lags or switches between
+them and one switch into each panel left but the first one entered, a switch costing at
+least its travel and how much longer the job after it takes than its least).
 
 It forgets lags between jobs whose ends it does not keep, the routes of robots of G between
 jobs that are not consecutive heavy ones, and which robot of a set does what. Every schedule
@@ -63,7 +69,7 @@ estimated over every set of its jobs done (2^12 sets)."""
 MAX_GRID = 1000
 MAX_OPEN = 500_000
 """The search stops, with the least value still open, when it has this many orders open
-(about 300 MB with what it has closed): 5 panels of the paper reach it in about 6 s."""
+(about 400 MB with what it has closed): 5 panels of the paper reach it in about 11 s."""
 
 
 def panel_sequence_bound(problem: Problem, incumbent: Fraction, time_limit: float
@@ -130,26 +136,55 @@ class _Search:
 
         self.travel = {key: ticks(v) for key, v in travel.items()}
         self.bare, self.helped = _Shape(bare, ticks), _Shape(helped, ticks)
+        self._ways_of_limited()
         arcs = list(problem.precedence) + [(a, b) for a, b, _ in problem.holding]
         for shape in (self.bare, self.helped):
             shape.jig_into = {i: h for i, h in shape.held.items() if {
                 b for a, b in arcs if a == shape.names[i]} == {shape.names[h]}}
         self.incumbent = ticks(incumbent)
+        self.crossing = {}
+        for (r, k, _, m, _), value in self.travel.items():
+            if r in limited and k != m:
+                self.crossing[r, k, m] = min(value, self.crossing.get((r, k, m), value))
         self.switch = self._least_switch()
         for shape in (self.bare, self.helped):
             shape.rest = _rest_costs(shape, self.switch)
 
+    def _ways_of_limited(self):
+        """What `_way` reads: per limited robot, from each job of a helped panel it could
+        have done last (or from nowhere yet), to each job of a helped panel it can do
+        (bit, travel, head, least duration with it, tail); and per panel, set of jobs done
+        and whether the tail counts, the least of those durations (plus tails) left."""
+        shape = self.helped
+        durations = [{n: min(c.duration for c in choices if robot in c.limited)
+                      for n, robot in enumerate(self.limited)
+                      if any(robot in c.limited for c in choices)} for choices in shape.choices]
+        starts = [None] + [(q, m) for q in range(self.panels) for m in range(len(shape.names))]
+        self.reach = {}
+        for n, robot in enumerate(self.limited):
+            able = [j for j, by_robot in enumerate(durations) if n in by_robot]
+            for at, k in itertools.product(starts, range(self.panels)):
+                self.reach[n, at, k] = [
+                    (1 << j, 0 if at is None else self.travel[
+                        robot, at[0], shape.names[at[1]], k, shape.names[j]],
+                     shape.heads[j], durations[j][n], shape.tails[j]) for j in able]
+            for last in (False, True):
+                shape.least_with[n, last] = [
+                    min((durations[j][n] + (shape.tails[j] if last else 0) for j in able
+                         if not done >> j & 1), default=None) for done in range(shape.full + 1)]
+
     def layouts(self, helped_count):
-        """Every set of `helped_count` panels, one of each pair of mirror images when the
-        travel between panels reads the same from the other end."""
+        """Every set of at most `helped_count` panels, one of each pair of mirror images
+        when the travel between panels reads the same from the other end."""
         last = self.panels - 1
         mirrored = all(value == self.travel[r, last - k, a, last - m, b]
                        for (r, k, a, m, b), value in self.travel.items())
         chosen = []
-        for helped in itertools.combinations(range(self.panels), helped_count):
-            mirror = tuple(sorted(last - k for k in helped))
-            if not (mirrored and mirror in chosen):
-                chosen.append(helped)
+        for count in range(helped_count + 1):
+            for helped in itertools.combinations(range(self.panels), count):
+                mirror = tuple(sorted(last - k for k in helped))
+                if not (mirrored and mirror in chosen):
+                    chosen.append(helped)
         return [tuple(self.helped if k in helped else self.bare for k in range(self.panels))
                 for helped in chosen]
 
@@ -212,15 +247,20 @@ class _Search:
         least value still open when the deadline comes (a lower bound either way); the
         incumbent when no order ends before it."""
         self.layout_shapes = layouts
+        self.helped_masks = [sum(1 << k for k, shape in enumerate(shapes) if shape is self.helped)
+                             for shapes in layouts]
         self.counter = itertools.count()
         self.frontier = []
         self.gaps = {}
+        self.first_steps = {}
         nobody = tuple(None for _ in self.limited)
         for layout, shapes in enumerate(layouts):
             progress = tuple(0 for _ in shapes)
-            state = (layout, progress, None, nobody, None)
-            self.frontier.append((self._estimate_anew(shapes, progress, None, -1),
-                                  next(self.counter), state, 0, 0, tuple(0 for _ in nobody)))
+            state = (layout, progress, None, nobody, None, 0)
+            free = tuple(0 for _ in nobody)
+            if self._visits_left(layout, progress, nobody, free, 0) < self.incumbent:
+                self.frontier.append((self._estimate_anew(shapes, progress, None, -1),
+                                      next(self.counter), state, 0, 0, free))
         heapq.heapify(self.frontier)
         closed = {}
         expansions = 0
@@ -230,9 +270,10 @@ class _Search:
                                           or len(self.frontier) > MAX_OPEN):
                 return Fraction(self.frontier[0][0], self.scale)
             value, _, state, now, latest, ends = heapq.heappop(self.frontier)
-            layout, progress, last, where, recent = state
+            layout, progress, last, where, recent, _ = state
             shapes = layouts[layout]
             if all(done == shape.full for done, shape in zip(progress, shapes, strict=True)):
+                # `_visits_left` let no order do a helped panel without a limited robot.
                 return Fraction(value, self.scale)
             labels = closed.setdefault(state, [])
             if any(t <= now and m <= latest and all(a <= b for a, b in zip(e, ends, strict=True))
@@ -275,7 +316,7 @@ class _Search:
         than the end of a last heavy job of its panel (which it follows, or follows a job
         that does), one placed elsewhere only after a last heavy job it shares a robot with
         or follows."""
-        (layout, _, last, where, _), now, _, ends = node
+        (layout, _, last, where, _, _), now, _, ends = node
         shapes = self.layout_shapes[layout]
         shape = shapes[k]
         begin = shape.heads[j]
@@ -309,14 +350,15 @@ class _Search:
         them): its robots are busy from its start to the held job's end, so a job placed
         before sharing a robot with it ended before it began, and its light staffing then
         needs no place of its own in the order."""
-        (layout, progress, last, where, recent), now, latest, ends = node
+        (layout, progress, last, where, recent, visited), now, latest, ends = node
         shape = self.layout_shapes[layout][k]
         if shape.before[held] & ~(progress[k] | 1 << j):
             return
         end = self._after_last(node, k, j, choice, eager=False) + choice.duration
         moved, new_ends = self._limited_at(where, ends, choice, k, j, end)
         after = progress[:k] + (progress[k] | 1 << j,) + progress[k + 1:]
-        inner = ((layout, after, last, moved, recent), now,
+        inner = ((layout, after, last, moved, recent, visited | (1 << k if choice.limited else 0)),
+                 now,
                  max(latest, end + shape.tails[j]), new_ends)
         for second in shape.choices[held]:
             if not any(a <= b for a in choice.sets for b in second.sets) or (
@@ -329,12 +371,14 @@ class _Search:
     def _place(self, node, k, j, choice, begin):
         """Push the order `node` continued by job j of panel k staffed by `choice` from
         `begin`, unless it cannot end before the incumbent."""
-        (layout, progress, last, where, recent), now, latest, ends = node
+        (layout, progress, last, where, recent, visited), now, latest, ends = node
         shapes = self.layout_shapes[layout]
         shape = shapes[k]
         after = progress[:k] + (progress[k] | 1 << j,) + progress[k + 1:]
         end = begin + choice.duration
         moved, new_ends = self._limited_at(where, ends, choice, k, j, end)
+        if choice.limited:
+            visited |= 1 << k
         new_latest = max(latest, end + shape.tails[j])
         if choice.heavy:
             new_now, new_last, new_recent = end, (k, j, choice), None
@@ -343,9 +387,11 @@ class _Search:
             new_now, new_last, new_recent = now, last, (k, j)
             bound = max(new_latest, now + self._estimate(
                 layout, after, last[0] if last else None, last[1] if last else -1))
-        if bound < self.incumbent:
+        if bound < self.incumbent and self._visits_left(
+                layout, after, moved, new_ends, visited) < self.incumbent:
             heapq.heappush(self.frontier, (
-                bound, next(self.counter), (layout, after, new_last, moved, new_recent),
+                bound, next(self.counter),
+                (layout, after, new_last, moved, new_recent, visited),
                 new_now, new_latest, new_ends))
 
     def _limited_at(self, where, ends, choice, k, j, end):
@@ -356,6 +402,55 @@ class _Search:
             if robot in choice.limited:
                 moved[n], new_ends[n] = (k, j), end
         return tuple(moved), tuple(new_ends)
+
+    def _visits_left(self, layout, progress, where, ends, visited):
+        """The least makespan for the limited robots to work in each of the layout's helped
+        panels where none has worked yet, after their last jobs: each such panel needs one
+        of them there, and each two such panels one robot going on from one to the other
+        or two robots (the largest of these over single panels and pairs; a robot's way is
+        `_way`). A panel with no job left that a limited robot can do is never reached: the
+        order belongs to a layout with fewer helped panels."""
+        left = [k for k in range(self.panels) if (self.helped_masks[layout] & ~visited) >> k & 1]
+        if not left:
+            return 0
+        shapes = self.layout_shapes[layout]
+        robots = range(len(self.limited))
+
+        def way(n, order):
+            return self._way(shapes, progress, n, where[n], ends[n], order)
+
+        alone = {k: [way(n, (k,)) for n in robots] for k in left}
+        latest = max(min(ways) for ways in alone.values())
+        for k, m in itertools.combinations(left, 2):
+            both = min(min(way(n, (k, m)), way(n, (m, k))) for n in robots)
+            for n, o in itertools.permutations(robots, 2):
+                both = min(both, max(alone[k][n], alone[m][o]))
+            latest = max(latest, both)
+        return latest
+
+    def _way(self, shapes, progress, n, at, free, order):
+        """The least end of limited robot n's way from its last job `at`, free from `free`,
+        through a job left in each panel of `order` in turn, with the last one's tail."""
+        time = None
+        for step, k in enumerate(order):
+            done = progress[k]
+            last = step == len(order) - 1
+            if step == 0:
+                key = (n, at, free, k, done, last)
+                least = self.first_steps.get(key, False)
+                if least is False:
+                    least = self.first_steps[key] = min(
+                        (max(free + travel, head) + duration + (tail if last else 0)
+                         for bit, travel, head, duration, tail in self.reach[n, at, k]
+                         if not done & bit), default=None)
+            else:
+                least = shapes[k].least_with[n, last][done]
+                if least is not None:
+                    least += time + self.crossing[self.limited[n], order[step - 1], k]
+            if least is None:
+                return self.incumbent
+            time = least
+        return time
 
     def _estimate(self, layout, progress, last_panel, last_job):
         """What is left after the last heavy job (job `last_job` of panel `last_panel`, or
@@ -416,6 +511,7 @@ class _Shape:
         self.least_tail = [min((self.tails[j] for j in left), default=0)
                            for left in heavy_left]
         self.rest = {}
+        self.least_with = {}
 
 
 class _Choice:
@@ -457,8 +553,11 @@ class _Paths:
         self.problem = problem
         places = problem.locations()
         self.index = {p: k for k, p in enumerate(places)}
-        far = [[problem.distances.get((a, b), Fraction(0) if a == b else None)
-                for b in places] for a in places]
+        # On integers (every distance times their common denominator): Fraction sums made
+        # this loop most of the bound's time on 5 panels (60 places).
+        scale = math.lcm(*(d.denominator for d in problem.distances.values()))
+        far = [[None if (a, b) not in problem.distances and a != b else
+                int(problem.distances.get((a, b), 0) * scale) for b in places] for a in places]
         for via in range(len(places)):
             row_via = far[via]
             for i in range(len(places)):
@@ -470,7 +569,7 @@ class _Paths:
                     onward = row_via[j]
                     if onward is not None and (row[j] is None or to_via + onward < row[j]):
                         row[j] = to_via + onward
-        self.paths = far
+        self.paths = [[None if d is None else Fraction(d, scale) for d in row] for row in far]
 
     def travel(self, robot, first, second) -> Fraction:
         """`first`, `second`: job names."""
