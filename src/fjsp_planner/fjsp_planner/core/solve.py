@@ -15,7 +15,7 @@ from fjsp_planner.core.greedy import (
 )
 from fjsp_planner.core.limits import MAX_WORKERS
 from fjsp_planner.core.load_bound import panel_load_bound
-from fjsp_planner.core.machine_bound import panel_machine_bound
+from fjsp_planner.core.machine_bound import EVERY_JOB_LIMIT, panel_machine_bound
 from fjsp_planner.core.panels import stitched_schedule
 from fjsp_planner.core.problem import Problem
 from fjsp_planner.core.schedule import Result, Schedule, Status
@@ -34,11 +34,12 @@ start stitched from their optima (`panels.stitched_schedule`) and the bound of o
 without the robots that cannot move between panels (`bounds.unhelped_panel`)."""
 MACHINE_SHARE = 0.1
 """Share of the time limit for the panel sequence bound (`sequence_bound`), then, with what it
-leaves, the panel machine bound (`machine_bound`). The sequence bound ends at once on 2
-panels of the paper, where the machine bound is solved to its optimum (91 1/3) in about 3 s;
-from 3 panels on it proves more (3 panels: 146 1/3 in 0.15 s, where the machine bound
-reaches about 126 in 6 s; 5 panels: 235 in 6 s, the machine bound about 190), and on 5 it
-takes the whole share."""
+leaves, the panel machine bound (`machine_bound`), which has at most half of the share when
+it does not keep every job (above `machine_bound.EVERY_JOB_LIMIT`). The sequence bound ends
+at once on 2 panels of the paper, where the machine bound is solved to its optimum (91 1/3)
+in about 3 s; from 3 panels on it proves more (3 panels: 146 1/3 in 0.15 s, where the
+machine bound reaches about 126 in 6 s; 5 panels: 235 in 6 s, the machine bound about 190),
+and on 5 it takes the whole share; above 6 panels it does not apply."""
 LOAD_SHARE = 0.05
 """Share of the time limit for the panel load bound (`load_bound`): it proves the loads alone
 on 2 to 10 panels of the paper in 0.1-2 s (2 workers), then counts waits for the rest."""
@@ -108,7 +109,8 @@ def solve(problem: Problem, solver: str = 'cpsat', time_limit: float = 10.0, wor
         share = MACHINE_SHARE * time_limit
         sequence_began = time.monotonic()
         sequence = panel_sequence_bound(problem, incumbent, share)
-        left = share - (time.monotonic() - sequence_began)
+        left = min(share - (time.monotonic() - sequence_began),
+                   share / 2 if len(problem.jobs) > EVERY_JOB_LIMIT else share)
         machine = (panel_machine_bound(problem, incumbent, left, workers)
                    if left >= MIN_PANEL_SECONDS else None)
         load = panel_load_bound(problem, incumbent, LOAD_SHARE * time_limit, workers)
