@@ -142,10 +142,6 @@ class _Search:
             shape.jig_into = {i: h for i, h in shape.held.items() if {
                 b for a, b in arcs if a == shape.names[i]} == {shape.names[h]}}
         self.incumbent = ticks(incumbent)
-        self.crossing = {}
-        for (r, k, _, m, _), value in self.travel.items():
-            if r in limited and k != m:
-                self.crossing[r, k, m] = min(value, self.crossing.get((r, k, m), value))
         self.switch = self._least_switch()
         for shape in (self.bare, self.helped):
             shape.rest = _rest_costs(shape, self.switch)
@@ -153,14 +149,19 @@ class _Search:
     def _ways_of_limited(self):
         """What `_way` reads: per limited robot, from each job of a helped panel it could
         have done last (or from nowhere yet), to each job of a helped panel it can do
-        (bit, travel, head, least duration with it, tail); and per panel, set of jobs done
-        and whether the tail counts, the least of those durations (plus tails) left."""
+        (bit, travel, head, least duration with it, tail); per set of jobs of a helped panel
+        done and whether the tail counts, the least of those durations (plus tails) left;
+        and its least travel between two panels."""
+        self.crossing = {}
+        for (r, k, _, m, _), value in self.travel.items():
+            if r in self.limited and k != m:
+                self.crossing[r, k, m] = min(value, self.crossing.get((r, k, m), value))
         shape = self.helped
         durations = [{n: min(c.duration for c in choices if robot in c.limited)
                       for n, robot in enumerate(self.limited)
                       if any(robot in c.limited for c in choices)} for choices in shape.choices]
         starts = [None] + [(q, m) for q in range(self.panels) for m in range(len(shape.names))]
-        self.reach = {}
+        self.reach, self.least_with = {}, {}
         for n, robot in enumerate(self.limited):
             able = [j for j, by_robot in enumerate(durations) if n in by_robot]
             for at, k in itertools.product(starts, range(self.panels)):
@@ -169,7 +170,7 @@ class _Search:
                         robot, at[0], shape.names[at[1]], k, shape.names[j]],
                      shape.heads[j], durations[j][n], shape.tails[j]) for j in able]
             for last in (False, True):
-                shape.least_with[n, last] = [
+                self.least_with[n, last] = [
                     min((durations[j][n] + (shape.tails[j] if last else 0) for j in able
                          if not done >> j & 1), default=None) for done in range(shape.full + 1)]
 
@@ -355,10 +356,9 @@ class _Search:
         if shape.before[held] & ~(progress[k] | 1 << j):
             return
         end = self._after_last(node, k, j, choice, eager=False) + choice.duration
-        moved, new_ends = self._limited_at(where, ends, choice, k, j, end)
+        moved, new_ends, visited = self._limited_at(where, ends, visited, choice, k, j, end)
         after = progress[:k] + (progress[k] | 1 << j,) + progress[k + 1:]
-        inner = ((layout, after, last, moved, recent, visited | (1 << k if choice.limited else 0)),
-                 now,
+        inner = ((layout, after, last, moved, recent, visited), now,
                  max(latest, end + shape.tails[j]), new_ends)
         for second in shape.choices[held]:
             if not any(a <= b for a in choice.sets for b in second.sets) or (
@@ -376,9 +376,7 @@ class _Search:
         shape = shapes[k]
         after = progress[:k] + (progress[k] | 1 << j,) + progress[k + 1:]
         end = begin + choice.duration
-        moved, new_ends = self._limited_at(where, ends, choice, k, j, end)
-        if choice.limited:
-            visited |= 1 << k
+        moved, new_ends, visited = self._limited_at(where, ends, visited, choice, k, j, end)
         new_latest = max(latest, end + shape.tails[j])
         if choice.heavy:
             new_now, new_last, new_recent = end, (k, j, choice), None
@@ -394,14 +392,14 @@ class _Search:
                 (layout, after, new_last, moved, new_recent, visited),
                 new_now, new_latest, new_ends))
 
-    def _limited_at(self, where, ends, choice, k, j, end):
-        """(each limited robot's last job, its end) once job j of panel k, staffed by
-        `choice`, ends at `end`."""
+    def _limited_at(self, where, ends, visited, choice, k, j, end):
+        """(each limited robot's last job, its end, the panels they have worked in) once job
+        j of panel k, staffed by `choice`, ends at `end`."""
         moved, new_ends = list(where), list(ends)
         for n, robot in enumerate(self.limited):
             if robot in choice.limited:
                 moved[n], new_ends[n] = (k, j), end
-        return tuple(moved), tuple(new_ends)
+        return tuple(moved), tuple(new_ends), visited | (1 << k if choice.limited else 0)
 
     def _visits_left(self, layout, progress, where, ends, visited):
         """The least makespan for the limited robots to work in each of the layout's helped
@@ -444,7 +442,7 @@ class _Search:
                          for bit, travel, head, duration, tail in self.reach[n, at, k]
                          if not done & bit), default=None)
             else:
-                least = shapes[k].least_with[n, last][done]
+                least = self.least_with[n, last][done]
                 if least is not None:
                     least += time + self.crossing[self.limited[n], order[step - 1], k]
             if least is None:
@@ -511,7 +509,6 @@ class _Shape:
         self.least_tail = [min((self.tails[j] for j in left), default=0)
                            for left in heavy_left]
         self.rest = {}
-        self.least_with = {}
 
 
 class _Choice:
