@@ -26,6 +26,17 @@ the job it holds into, which keeps its robots: they are busy from its start to t
 job's end, so a job placed before it sharing one of them ended before it began, and its
 limited robot does nothing in between.
 
+A heavy job and a light one with a limited robot never overlap either when every robot set
+of the one shares a robot with every one of the other's (the paper's Assembler with a MARC,
+and a heavy job of both MARCs elsewhere): one ends, and the robots they share travel, before
+the other begins. The order keeps the times of each limited robot's last few light jobs
+(`TRACKED`, less those that end too early to hold up a heavy job to come) and of the last
+heavy job. A heavy job placed comes after the first few of a robot's light jobs it clashes
+with and before the others, which then begin after it (and the robot's later ones after
+them); a light job placed comes before the last heavy job or after it. Whichever was placed
+earlier may be taken later; what was placed after it then starts earlier than it could,
+which only lowers the bound.
+
 Every schedule has a set of panels where limited robots work on kept jobs, at most the sum
 of their limits; in the other panels the kept jobs are staffed from G. The search takes each
 such set on its own (its *layout*): a limited robot works in each of its panels, so an order
@@ -35,11 +46,12 @@ or two robots; panels a robot cannot reach in time rule the layout out), and an 
 does every job of such a panel without one belongs to another layout. Its value is the least
 makespan over such orders, each job at its least duration for the robots chosen plus the
 least time after its end (its tail), over every layout: a best-first search over (the
-layout, which jobs of each panel are done, the last heavy one, each limited robot's last one
-and the panels they have worked in), with an estimate of what is left that never overstates
-it (the least durations of the jobs only heavy staffings can do, the lags or switches between
-them and one switch into each panel left but the first one entered, a switch costing at
-least its travel and how much longer the job after it takes than its least).
+layout, which jobs of each panel are done, the last heavy one, each limited robot's last one,
+the panels they have worked in and their light jobs kept), with an estimate of what is left
+that never overstates it (the least durations of the jobs only heavy staffings can do, the
+lags or switches between them and one switch into each panel left but the first one
+entered, a switch costing at least its travel and how much longer the job after it takes
+than its least).
 
 It forgets lags between jobs whose ends it does not keep, the routes of robots of G between
 jobs that are not consecutive heavy ones, and which robot of a set does what. Every schedule
@@ -67,9 +79,13 @@ MAX_PANEL_JOBS = 12
 """Above this many kept jobs in a panel the search is not run: what is left of a panel is
 estimated over every set of its jobs done (2^12 sets)."""
 MAX_GRID = 1000
+TRACKED = 3
+"""How many of a limited robot's last light jobs the state keeps, for heavy jobs to keep
+clear of: the paper's Assembler does three in a panel it helps without a heavy job
+between (`Ac`, `Jd`, `Ad`)."""
 MAX_OPEN = 500_000
 """The search stops, with the least value still open, when it has this many orders open
-(about 400 MB with what it has closed): 5 panels of the paper reach it in about 11 s."""
+(about 750 MB with what it has closed): 5 panels of the paper reach it in about 19 s."""
 
 
 def panel_sequence_bound(problem: Problem, incumbent: Fraction, time_limit: float
@@ -143,6 +159,8 @@ class _Search:
                 b for a, b in arcs if a == shape.names[i]} == {shape.names[h]}}
         self.incumbent = ticks(incumbent)
         self.switch = self._least_switch()
+        self.farthest = max((value for (r, *_), value in self.travel.items()
+                             if r not in limited), default=0)
         for shape in (self.bare, self.helped):
             shape.rest = _rest_costs(shape, self.switch)
 
@@ -253,15 +271,17 @@ class _Search:
         self.counter = itertools.count()
         self.frontier = []
         self.gaps = {}
+        self.clashes = {}
         self.first_steps = {}
         nobody = tuple(None for _ in self.limited)
+        untracked = tuple(() for _ in self.limited)
         for layout, shapes in enumerate(layouts):
             progress = tuple(0 for _ in shapes)
-            state = (layout, progress, None, nobody, None, 0)
+            state = (layout, progress, None, nobody, None, 0, untracked)
             free = tuple(0 for _ in nobody)
             if self._visits_left(layout, progress, nobody, free, 0) < self.incumbent:
                 self.frontier.append((self._estimate_anew(shapes, progress, None, -1),
-                                      next(self.counter), state, 0, 0, free))
+                                      next(self.counter), state, 0, 0, free, untracked))
         heapq.heapify(self.frontier)
         closed = {}
         expansions = 0
@@ -270,18 +290,20 @@ class _Search:
             if expansions % 512 == 0 and (time.monotonic() > deadline
                                           or len(self.frontier) > MAX_OPEN):
                 return Fraction(self.frontier[0][0], self.scale)
-            value, _, state, now, latest, ends = heapq.heappop(self.frontier)
-            layout, progress, last, where, recent, _ = state
+            value, _, state, now, latest, ends, light_ends = heapq.heappop(self.frontier)
+            layout, progress, last, where, recent, _, _ = state
             shapes = layouts[layout]
             if all(done == shape.full for done, shape in zip(progress, shapes, strict=True)):
                 # `_visits_left` let no order do a helped panel without a limited robot.
                 return Fraction(value, self.scale)
             labels = closed.setdefault(state, [])
             if any(t <= now and m <= latest and all(a <= b for a, b in zip(e, ends, strict=True))
-                   for t, m, e in labels):
+                   and all(a <= b for x, y in zip(le, light_ends, strict=True)
+                           for a, b in zip(x, y, strict=True))
+                   for t, m, e, le in labels):
                 continue
-            labels.append((now, latest, ends))
-            node = (state, now, latest, ends)
+            labels.append((now, latest, ends, light_ends))
+            node = (state, now, latest, ends, light_ends)
             self.estimates = {}
             forced = None
             if last is not None:
@@ -317,7 +339,7 @@ class _Search:
         than the end of a last heavy job of its panel (which it follows, or follows a job
         that does), one placed elsewhere only after a last heavy job it shares a robot with
         or follows."""
-        (layout, _, last, where, _, _), now, _, ends = node
+        (layout, _, last, where, _, _, _), now, _, ends, _ = node
         shapes = self.layout_shapes[layout]
         shape = shapes[k]
         begin = shape.heads[j]
@@ -325,13 +347,7 @@ class _Search:
             p, i, last_choice = last
             if choice.heavy or not eager and all(
                     x & y for x in last_choice.sets for y in choice.sets):
-                key = (p, i, last_choice, k, j, choice)
-                gap = self.gaps.get(key)
-                if gap is None:
-                    gap = self.gap(p, last_choice, shapes[p].names[i], k, choice,
-                                   shape.names[j])
-                    self.gaps[key] = gap
-                begin = max(begin, now + gap)
+                begin = max(begin, now + self._gap_between(shapes, last, (k, j, choice)))
             if p == k and (eager and not choice.heavy or (i, j) in shape.lags):
                 begin = max(begin, now + shape.lags.get((i, j), 0))
         for n, robot in enumerate(self.limited):
@@ -351,15 +367,17 @@ class _Search:
         them): its robots are busy from its start to the held job's end, so a job placed
         before sharing a robot with it ended before it began, and its light staffing then
         needs no place of its own in the order."""
-        (layout, progress, last, where, recent, visited), now, latest, ends = node
+        (layout, progress, last, where, recent, visited, light), now, latest, ends, \
+            light_ends = node
         shape = self.layout_shapes[layout][k]
         if shape.before[held] & ~(progress[k] | 1 << j):
             return
         end = self._after_last(node, k, j, choice, eager=False) + choice.duration
-        moved, new_ends, visited = self._limited_at(where, ends, visited, choice, k, j, end)
+        moved, new_ends, visited, light, light_ends = self._limited_at(
+            where, ends, visited, light, light_ends, choice, k, j, end)
         after = progress[:k] + (progress[k] | 1 << j,) + progress[k + 1:]
-        inner = ((layout, after, last, moved, recent, visited), now,
-                 max(latest, end + shape.tails[j]), new_ends)
+        inner = ((layout, after, last, moved, recent, visited, light), now,
+                 max(latest, end + shape.tails[j]), new_ends, light_ends)
         for second in shape.choices[held]:
             if not any(a <= b for a in choice.sets for b in second.sets) or (
                     second.heavy and forced is not None and forced != (k, held)):
@@ -370,36 +388,164 @@ class _Search:
 
     def _place(self, node, k, j, choice, begin):
         """Push the order `node` continued by job j of panel k staffed by `choice` from
-        `begin`, unless it cannot end before the incumbent."""
-        (layout, progress, last, where, recent, visited), now, latest, ends = node
+        `begin`, in each way it keeps clear of the jobs it cannot overlap (`_apart`),
+        unless it cannot end before the incumbent."""
+        (layout, progress, last, where, recent, visited, light), *_ = node
         shapes = self.layout_shapes[layout]
         shape = shapes[k]
         after = progress[:k] + (progress[k] | 1 << j,) + progress[k + 1:]
-        end = begin + choice.duration
-        moved, new_ends, visited = self._limited_at(where, ends, visited, choice, k, j, end)
-        new_latest = max(latest, end + shape.tails[j])
-        if choice.heavy:
-            new_now, new_last, new_recent = end, (k, j, choice), None
-            bound = max(new_latest, end + self._estimate(layout, after, k, j))
-        else:
-            new_now, new_last, new_recent = now, last, (k, j)
-            bound = max(new_latest, now + self._estimate(
-                layout, after, last[0] if last else None, last[1] if last else -1))
-        if bound < self.incumbent and self._visits_left(
-                layout, after, moved, new_ends, visited) < self.incumbent:
+        for start, now, latest, ends, light_ends in self._apart(node, k, j, choice, begin):
+            end = start + choice.duration
+            moved, new_ends, new_visited, new_light, new_light_ends = self._limited_at(
+                where, ends, visited, light, light_ends, choice, k, j, end)
+            new_latest = max(latest, end + shape.tails[j])
+            if choice.heavy:
+                new_now, new_last, new_recent = end, (k, j, choice), None
+                bound = max(new_latest, end + self._estimate(layout, after, k, j))
+            else:
+                new_now, new_last, new_recent = now, last, (k, j)
+                bound = max(new_latest, now + self._estimate(
+                    layout, after, last[0] if last else None, last[1] if last else -1))
+            if bound >= self.incumbent or self._visits_left(
+                    layout, after, moved, new_ends, new_visited) >= self.incumbent:
+                continue
+            new_light, new_light_ends = self._still_near(new_light, new_light_ends, new_now)
             heapq.heappush(self.frontier, (
                 bound, next(self.counter),
-                (layout, after, new_last, moved, new_recent, visited),
-                new_now, new_latest, new_ends))
+                (layout, after, new_last, moved, new_recent, new_visited, new_light),
+                new_now, new_latest, new_ends, new_light_ends))
 
-    def _limited_at(self, where, ends, visited, choice, k, j, end):
-        """(each limited robot's last job, its end, the panels they have worked in) once job
-        j of panel k, staffed by `choice`, ends at `end`."""
+    def _still_near(self, light, light_ends, now):
+        """The light jobs kept per limited robot less those that end too early to keep a
+        heavy job starting after `now` waiting (the longest travel of a robot of G)."""
+        kept = [tuple(t for t, end in enumerate(ends) if end + self.farthest > now)
+                for ends in light_ends]
+        if all(len(mine) == len(ends) for mine, ends in zip(kept, light_ends, strict=True)):
+            return light, light_ends
+        return (tuple(tuple(jobs[t] for t in mine)
+                      for jobs, mine in zip(light, kept, strict=True)),
+                tuple(tuple(ends[t] for t in mine)
+                      for ends, mine in zip(light_ends, kept, strict=True)))
+
+    def _apart(self, node, k, j, choice, begin):
+        """(begin, the last heavy job's end, latest end plus tail, the limited robots' ends,
+        the ends of their light jobs kept) for each way job j of panel k, staffed by
+        `choice`, keeps clear of the jobs whose every robot set shares a robot with every
+        one of its own, among those the order keeps the times of: a heavy job of the light
+        jobs of limited robots kept in the state, a light one of the last heavy job. Two
+        such jobs never overlap, so one ends, and its shared robots travel, before the
+        other begins: either the new job waits, or the one placed earlier is taken to begin
+        after it (what was placed after that one then starts earlier than it could, which
+        only lowers the bound)."""
+        (layout, _, last, _, _, _, light), now, latest, ends, light_ends = node
+        shapes = self.layout_shapes[layout]
+        ways = [(begin, now, latest, ends, light_ends)]
+        if choice.heavy:
+            for n, jobs in enumerate(light):
+                if jobs:
+                    ways = [way for old in ways for way in self._apart_from_light(
+                        shapes, old, n, jobs, (k, j, choice))]
+        elif last is not None and self._clash(last[2], choice):
+            p, i, last_choice = last
+            into = self._gap_between(shapes, last, (k, j, choice))
+            if begin >= now + into:
+                return ways
+            follows = p == k and (i, j) in shapes[k].lags
+            back = self._gap_between(shapes, (k, j, choice), last)
+            start = now - last_choice.duration
+            if not follows and begin + choice.duration + back <= start:
+                return ways
+            ways = [(now + into, now, latest, ends, light_ends)]
+            if not follows:
+                moved = begin + choice.duration + back + last_choice.duration
+                ways.append((begin, moved, max(latest, moved + shapes[p].tails[i]), ends,
+                             light_ends))
+        return ways
+
+    def _apart_from_light(self, shapes, way, n, jobs, heavy_job):
+        """`_apart`'s ways, from `way`, for heavy job `heavy_job` (panel, job, choice) and
+        limited robot n's light jobs kept, `jobs` (each (panel, job, choice), in the robot's
+        order, the last one its last job): the heavy job comes after the first few of those
+        it clashes with and before the others, which then begin after it, and each job of
+        the robot after one taken later no earlier than its end and the robot's way on."""
+        begin, now, latest, ends, light_ends = way
+        k, j, heavy_choice = heavy_job
+        mine = light_ends[n]
+        clashing = []
+        for t, job in enumerate(jobs):
+            q, m, light_choice = job
+            if self._clash(light_choice, heavy_choice):
+                clashing.append((t, self._gap_between(shapes, job, heavy_job),
+                                 self._gap_between(shapes, heavy_job, job),
+                                 q == k and (m, j) in shapes[k].lags))
+        ways = []
+        for split in range(len(clashing) + 1):
+            if any(follows for *_, follows in clashing[split:]):
+                continue
+            start = max([begin] + [mine[t] + into for t, into, _, _ in clashing[:split]])
+            end = start + heavy_choice.duration
+            after = {t: back for t, _, back, _ in clashing[split:]}
+            moved, new_latest = list(mine), latest
+            for t, (q, m, light_choice) in enumerate(jobs):
+                light_start = mine[t] - light_choice.duration
+                if t in after:
+                    light_start = max(light_start, end + after[t])
+                if t and moved[t - 1] > mine[t - 1]:
+                    light_start = max(light_start, moved[t - 1] + self._link(
+                        shapes, n, jobs[t - 1], jobs[t]))
+                moved[t] = max(mine[t], light_start + light_choice.duration)
+                new_latest = max(new_latest, moved[t] + shapes[q].tails[m])
+            if start == begin and moved == list(mine):
+                return [way]
+            new_ends = ends[:n] + (moved[-1],) + ends[n + 1:]
+            ways.append((start, now, new_latest, new_ends,
+                         light_ends[:n] + (tuple(moved),) + light_ends[n + 1:]))
+        return ways
+
+    def _link(self, shapes, n, first, second):
+        """Least time from the end of limited robot n's job `first` to the start of its next
+        one, `second` (each (panel, job, choice)): its travel, or a chain's lag between them."""
+        q, m, _ = first
+        k, j, _ = second
+        travel = self.travel[self.limited[n], q, shapes[q].names[m], k, shapes[k].names[j]]
+        return max(travel, shapes[k].lags.get((m, j), 0) if q == k else 0)
+
+    def _clash(self, first, second):
+        """Whether every robot set of one choice shares a robot with every one of the
+        other's, so that the two jobs never overlap."""
+        key = (first, second)
+        found = self.clashes.get(key)
+        if found is None:
+            found = self.clashes[key] = all(x & y for x in first.sets for y in second.sets)
+        return found
+
+    def _gap_between(self, shapes, first, second):
+        """`gap` from the end of `first` to the start of `second`, each (panel, job, choice)."""
+        p, i, first_choice = first
+        k, j, choice = second
+        key = (p, i, first_choice, k, j, choice)
+        found = self.gaps.get(key)
+        if found is None:
+            found = self.gaps[key] = self.gap(p, first_choice, shapes[p].names[i], k, choice,
+                                              shapes[k].names[j])
+        return found
+
+    def _limited_at(self, where, ends, visited, light, light_ends, choice, k, j, end):
+        """(each limited robot's last job, its end, the panels they have worked in, its
+        light jobs kept and their ends) once job j of panel k, staffed by `choice`, ends at
+        `end`. A heavy job ends what a robot's light jobs before it can hold up."""
         moved, new_ends = list(where), list(ends)
+        new_light, new_light_ends = list(light), list(light_ends)
         for n, robot in enumerate(self.limited):
             if robot in choice.limited:
                 moved[n], new_ends[n] = (k, j), end
-        return tuple(moved), tuple(new_ends), visited | (1 << k if choice.limited else 0)
+                if choice.heavy:
+                    new_light[n], new_light_ends[n] = (), ()
+                else:
+                    new_light[n] = (light[n] + ((k, j, choice),))[-TRACKED:]
+                    new_light_ends[n] = (light_ends[n] + (end,))[-TRACKED:]
+        return (tuple(moved), tuple(new_ends), visited | (1 << k if choice.limited else 0),
+                tuple(new_light), tuple(new_light_ends))
 
     def _visits_left(self, layout, progress, where, ends, visited):
         """The least makespan for the limited robots to work in each of the layout's helped
