@@ -401,7 +401,7 @@ def test_sequence_bound_meets_proven_optima_where_a_robot_reaches_two_of_three_p
     B walking to each (40 1/2 and 32 when a layout of two panels also held the orders of
     B working in one; checked outside the suite on 81 such panels: none above its optimum,
     15 raised)."""
-    problem = three_panels_b_crosses(seed, crossing)
+    problem = slow_crossers(seed, crossing, 3, 1, mover_too=False)
     exact = solve(problem, time_limit=20)
     assert exact.status == Status.OPTIMAL and exact.makespan == optimum
     assert bounds.panel_limits(problem, optimum + 1) == {'B': 2}
@@ -416,20 +416,40 @@ def test_sequence_bound_keeps_light_jobs_of_b_clear_of_heavy_jobs_sharing_an_arm
     needing that arm, or every arm, never overlap: the bound meets the proven optima (it
     gave 52 and 44 1/20 when B's light jobs took nothing from the heavy jobs; checked
     outside the suite on jig panels: none above its optimum)."""
-    problem = three_panels_b_crosses(seed, crossing)
+    problem = slow_crossers(seed, crossing, 3, 1, mover_too=False)
     exact = solve(problem, time_limit=20)
     assert exact.status == Status.OPTIMAL and exact.makespan == optimum
     assert bounds.panel_limits(problem, optimum + 1) == {'B': 2}
     assert panel_sequence_bound(problem, optimum + 1, 20) == optimum
 
 
-def three_panels_b_crosses(seed: int, crossing: Fraction) -> Problem:
-    """`jig_panel(seed)` with B crossing at `crossing` per unit of distance, 3 panels 1
-    apart."""
+@pytest.mark.parametrize(('seed', 'shift', 'mover_too', 'optimum', 'bound'), [
+    (6, 2, False, 56, 54), (39, 2, True, Fraction(584, 5), Fraction(584, 5))])
+def test_sequence_bound_brings_each_robot_of_g_from_its_last_heavy_job(
+        seed, shift, mover_too, optimum, bound):
+    """3 panels `shift` apart of `jig_panel(seed)`, B crossing at 671/40 or 259/10 per unit
+    of distance (with `mover_too`, L at twice that, and L is the one within reach of two
+    panels only). A heavy job starts no earlier than each robot all its staffings need can
+    come from its last heavy job, not only those it shares with the heavy job before: the
+    bound rises from 50 to 54 (optimum 56) and from 95 to the optimum, 116 4/5. The optima
+    are CP-SAT's, proven."""
+    crossing = Fraction(259, 10) if mover_too else Fraction(671, 40)
+    problem = slow_crossers(seed, crossing, 3, shift, mover_too)
+    exact = solve(problem, time_limit=20)
+    assert exact.status == Status.OPTIMAL and exact.makespan == optimum
+    assert panel_sequence_bound(problem, optimum + 1, 20) == bound <= optimum
+
+
+def slow_crossers(seed: int, crossing: Fraction, panels: int, shift: int, mover_too: bool
+                  ) -> Problem:
+    """`jig_panel(seed)` with B crossing at `crossing` per unit of distance, and L at
+    twice that if `mover_too`, repeated."""
     panel = jig_panel(seed)
     types = dict(panel.robot_types)
     types['Big'] = {**types['Big'], 2: crossing}
-    return repeat_panels(dataclasses.replace(panel, robot_types=types), 3, 1)
+    if mover_too:
+        types['Mover'] = {**types['Mover'], 2: 2 * crossing}
+    return repeat_panels(dataclasses.replace(panel, robot_types=types), panels, shift)
 
 
 def test_load_bound_on_the_tiny_panels(two_panels_optimum):

@@ -15,6 +15,10 @@ starts no earlier than:
   both share, along the places of the panels *where they lie* (the paper's panels lie in a
   row: from the fifth back to the second is three crossings), or the lag a precedence chain
   puts between the two when they are of one panel;
+- when heavy, for each robot of G that all its robot sets have, the end of that robot's
+  last heavy job (the last one all of whose sets have it) plus its least travel from a kept
+  job of that job's panel (on the paper, MARC2 coming back along the row while the heavy
+  job before shared only LSMS with it, which crosses in 2);
 - when it has a limited robot, the end of that robot's job before it plus its least travel
   from there;
 - the end of either of those plus the lag of a chain from it, when it precedes the job.
@@ -47,17 +51,17 @@ does every job of such a panel without one belongs to another layout. Its value 
 makespan over such orders, each job at its least duration for the robots chosen plus the
 least time after its end (its tail), over every layout: a best-first search over (the
 layout, which jobs of each panel are done, the last heavy one, each limited robot's last one,
-the panels they have worked in and their light jobs kept), with an estimate of what is left
-that never overstates it (the least durations of the jobs only heavy staffings can do, the
-lags or switches between them and one switch into each panel left but the first one
-entered, a switch costing at least its travel and how much longer the job after it takes
-than its least).
+the panels they have worked in and their light jobs kept, the panel of each robot of G's
+last heavy job), with an estimate of what is left that never overstates it (the least
+durations of the jobs only heavy staffings can do, the lags or switches between them and one
+switch into each panel left but the first one entered, a switch costing at least its travel
+and how much longer the job after it takes than its least).
 
-It forgets lags between jobs whose ends it does not keep, the routes of robots of G between
-jobs that are not consecutive heavy ones, and which robot of a set does what. Every schedule
-shorter than U is one of these orders, so the search's least value, or the least value still
-open when its time runs out, bounds every schedule shorter than U, and min(bound, U) bounds
-all. CP-SAT's model of a similar relaxation (`machine_bound`), which knows no panel's place,
+It forgets lags between jobs whose ends it does not keep, the ways of robots of G but from
+their last heavy jobs, and which robot of a set does what. Every schedule shorter than U is
+one of these orders, so the search's least value, or the least value still open when its
+time runs out, bounds every schedule shorter than U, and min(bound, U) bounds all. CP-SAT's
+model of a similar relaxation (`machine_bound`), which knows no panel's place,
 proves about 200 on 5 panels of the paper in minutes.
 """
 
@@ -161,6 +165,12 @@ class _Search:
         self.switch = self._least_switch()
         self.farthest = max((value for (r, *_), value in self.travel.items()
                              if r not in limited), default=0)
+        self.group = sorted({r for r, *_ in self.travel} - set(limited))
+        self.leave = {}
+        for (r, q, _, k, b), value in self.travel.items():
+            if r not in limited:
+                key = (r, q, k, b)
+                self.leave[key] = min(value, self.leave.get(key, value))
         for shape in (self.bare, self.helped):
             shape.rest = _rest_costs(shape, self.switch)
 
@@ -272,16 +282,19 @@ class _Search:
         self.frontier = []
         self.gaps = {}
         self.clashes = {}
+        self.clashing = {}
         self.first_steps = {}
         nobody = tuple(None for _ in self.limited)
         untracked = tuple(() for _ in self.limited)
+        nowhere = tuple(None for _ in self.group)
+        idle = tuple(0 for _ in self.group)
         for layout, shapes in enumerate(layouts):
             progress = tuple(0 for _ in shapes)
-            state = (layout, progress, None, nobody, None, 0, untracked)
+            state = (layout, progress, None, nobody, None, 0, untracked, nowhere)
             free = tuple(0 for _ in nobody)
             if self._visits_left(layout, progress, nobody, free, 0) < self.incumbent:
                 self.frontier.append((self._estimate_anew(shapes, progress, None, -1),
-                                      next(self.counter), state, 0, 0, free, untracked))
+                                      next(self.counter), state, 0, 0, free, untracked, idle))
         heapq.heapify(self.frontier)
         closed = {}
         expansions = 0
@@ -290,8 +303,8 @@ class _Search:
             if expansions % 512 == 0 and (time.monotonic() > deadline
                                           or len(self.frontier) > MAX_OPEN):
                 return Fraction(self.frontier[0][0], self.scale)
-            value, _, state, now, latest, ends, light_ends = heapq.heappop(self.frontier)
-            layout, progress, last, where, recent, _, _ = state
+            value, _, state, now, latest, ends, light_ends, free = heapq.heappop(self.frontier)
+            layout, progress, last, where, recent, *_ = state
             shapes = layouts[layout]
             if all(done == shape.full for done, shape in zip(progress, shapes, strict=True)):
                 # `_visits_left` let no order do a helped panel without a limited robot.
@@ -300,10 +313,11 @@ class _Search:
             if any(t <= now and m <= latest and all(a <= b for a, b in zip(e, ends, strict=True))
                    and all(a <= b for x, y in zip(le, light_ends, strict=True)
                            for a, b in zip(x, y, strict=True))
-                   for t, m, e, le in labels):
+                   and all(a <= b for a, b in zip(f, free, strict=True))
+                   for t, m, e, le, f in labels):
                 continue
-            labels.append((now, latest, ends, light_ends))
-            node = (state, now, latest, ends, light_ends)
+            labels.append((now, latest, ends, light_ends, free))
+            node = (state, now, latest, ends, light_ends, free)
             self.estimates = {}
             forced = None
             if last is not None:
@@ -339,10 +353,15 @@ class _Search:
         than the end of a last heavy job of its panel (which it follows, or follows a job
         that does), one placed elsewhere only after a last heavy job it shares a robot with
         or follows."""
-        (layout, _, last, where, _, _, _), now, _, ends, _ = node
+        (layout, _, last, where, *_, at), now, _, ends, _, free = node
         shapes = self.layout_shapes[layout]
         shape = shapes[k]
         begin = shape.heads[j]
+        if choice.heavy:
+            name = shape.names[j]
+            for g, robot in enumerate(self.group):
+                if at[g] is not None and robot in choice.always:
+                    begin = max(begin, free[g] + self.leave[robot, at[g], k, name])
         if last is not None:
             p, i, last_choice = last
             if choice.heavy or not eager and all(
@@ -367,8 +386,8 @@ class _Search:
         them): its robots are busy from its start to the held job's end, so a job placed
         before sharing a robot with it ended before it began, and its light staffing then
         needs no place of its own in the order."""
-        (layout, progress, last, where, recent, visited, light), now, latest, ends, \
-            light_ends = node
+        (layout, progress, last, where, recent, visited, light, at), now, latest, ends, \
+            light_ends, free = node
         shape = self.layout_shapes[layout][k]
         if shape.before[held] & ~(progress[k] | 1 << j):
             return
@@ -376,8 +395,8 @@ class _Search:
         moved, new_ends, visited, light, light_ends = self._limited_at(
             where, ends, visited, light, light_ends, choice, k, j, end)
         after = progress[:k] + (progress[k] | 1 << j,) + progress[k + 1:]
-        inner = ((layout, after, last, moved, recent, visited, light), now,
-                 max(latest, end + shape.tails[j]), new_ends, light_ends)
+        inner = ((layout, after, last, moved, recent, visited, light, at), now,
+                 max(latest, end + shape.tails[j]), new_ends, light_ends, free)
         for second in shape.choices[held]:
             if not any(a <= b for a in choice.sets for b in second.sets) or (
                     second.heavy and forced is not None and forced != (k, held)):
@@ -390,7 +409,7 @@ class _Search:
         """Push the order `node` continued by job j of panel k staffed by `choice` from
         `begin`, in each way it keeps clear of the jobs it cannot overlap (`_apart`),
         unless it cannot end before the incumbent."""
-        (layout, progress, last, where, recent, visited, light), *_ = node
+        (layout, progress, last, where, recent, visited, light, at), *_, free = node
         shapes = self.layout_shapes[layout]
         shape = shapes[k]
         after = progress[:k] + (progress[k] | 1 << j,) + progress[k + 1:]
@@ -410,10 +429,25 @@ class _Search:
                     layout, after, moved, new_ends, new_visited) >= self.incumbent:
                 continue
             new_light, new_light_ends = self._still_near(new_light, new_light_ends, new_now)
+            new_at, new_free = self._group_at(at, free, choice, k, end)
             heapq.heappush(self.frontier, (
                 bound, next(self.counter),
-                (layout, after, new_last, moved, new_recent, new_visited, new_light),
-                new_now, new_latest, new_ends, new_light_ends))
+                (layout, after, new_last, moved, new_recent, new_visited, new_light, new_at),
+                new_now, new_latest, new_ends, new_light_ends, new_free))
+
+    def _group_at(self, at, free, choice, k, end):
+        """(the panel of each robot of G's last heavy job, when known, and its end) once a
+        job of panel k, staffed by `choice`, ends at `end`: a heavy job moves the robots all
+        its sets have there, and leaves unknown where those only some have are."""
+        if not choice.heavy:
+            return at, free
+        new_at, new_free = list(at), list(free)
+        for g, robot in enumerate(self.group):
+            if robot in choice.always:
+                new_at[g], new_free[g] = k, end
+            elif robot in choice.anyone:
+                new_at[g] = None
+        return tuple(new_at), tuple(new_free)
 
     def _still_near(self, light, light_ends, now):
         """The light jobs kept per limited robot less those that end too early to keep a
@@ -437,7 +471,7 @@ class _Search:
         other begins: either the new job waits, or the one placed earlier is taken to begin
         after it (what was placed after that one then starts earlier than it could, which
         only lowers the bound)."""
-        (layout, _, last, _, _, _, light), now, latest, ends, light_ends = node
+        (layout, _, last, _, _, _, light, _), now, latest, ends, light_ends, _ = node
         shapes = self.layout_shapes[layout]
         ways = [(begin, now, latest, ends, light_ends)]
         if choice.heavy:
@@ -471,13 +505,15 @@ class _Search:
         begin, now, latest, ends, light_ends = way
         k, j, heavy_choice = heavy_job
         mine = light_ends[n]
-        clashing = []
-        for t, job in enumerate(jobs):
-            q, m, light_choice = job
-            if self._clash(light_choice, heavy_choice):
-                clashing.append((t, self._gap_between(shapes, job, heavy_job),
-                                 self._gap_between(shapes, heavy_job, job),
-                                 q == k and (m, j) in shapes[k].lags))
+        clashing = self.clashing.get((jobs, heavy_job))
+        if clashing is None:
+            clashing = self.clashing[jobs, heavy_job] = [
+                (t, self._gap_between(shapes, job, heavy_job),
+                 self._gap_between(shapes, heavy_job, job), job[0] == k and (job[1], j) in
+                 shapes[k].lags)
+                for t, job in enumerate(jobs) if self._clash(job[2], heavy_choice)]
+        if not clashing:
+            return [way]
         ways = []
         for split in range(len(clashing) + 1):
             if any(follows for *_, follows in clashing[split:]):
@@ -660,6 +696,8 @@ class _Shape:
 class _Choice:
     def __init__(self, duration, sets, heavy, limited):
         self.duration, self.sets, self.heavy, self.limited = duration, sets, heavy, limited
+        self.always = frozenset.intersection(*map(frozenset, sets))
+        self.anyone = frozenset.union(*map(frozenset, sets))
 
 
 def _rest_costs(shape, switch):
