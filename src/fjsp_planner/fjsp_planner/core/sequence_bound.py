@@ -68,7 +68,9 @@ proves about 200 on 5 panels of the paper in minutes.
 import heapq
 import itertools
 import math
+import threading
 import time
+from collections.abc import Callable
 from fractions import Fraction
 
 from fjsp_planner.core.bounds import panel_limits
@@ -92,11 +94,16 @@ MAX_OPEN = 500_000
 (about 750 MB with what it has closed): 5 panels of the paper reach it in about 19 s."""
 
 
-def panel_sequence_bound(problem: Problem, incumbent: Fraction, time_limit: float
+def panel_sequence_bound(problem: Problem, incumbent: Fraction, time_limit: float,
+                         stop: threading.Event | None = None,
+                         improved: Callable[[], Fraction | None] | None = None
                          ) -> Fraction | None:
     """The bound of the module docstring, or None when it does not apply (fewer than two
     or more than MAX_PANELS panels, running jobs, no robot of G, no job kept or more than
-    MAX_PANEL_JOBS of them in a panel)."""
+    MAX_PANEL_JOBS of them in a panel). The search ends early, with the least value still
+    open, once `stop` is set; `improved` gives the makespan of a shorter schedule found
+    meanwhile, if any (orders that cannot end before it are then dropped too, and the
+    bound holds below it)."""
     panels = len(problem.panels)
     if not 2 <= panels <= MAX_PANELS or problem.fixed:
         return None
@@ -114,7 +121,9 @@ def panel_sequence_bound(problem: Problem, incumbent: Fraction, time_limit: floa
         return None
     search = _Search(problem, bare, helped, sorted(limits), incumbent)
     layouts = search.layouts(helped_count)
-    return min(search.run(layouts, deadline), incumbent)
+    found = min(search.run(layouts, deadline, stop, improved), incumbent)
+    shorter = improved() if improved is not None else None
+    return found if shorter is None else min(found, shorter)
 
 
 def _kept_jobs(problem, allowed, group, limited, incumbent):
@@ -162,6 +171,7 @@ class _Search:
             shape.jig_into = {i: h for i, h in shape.held.items() if {
                 b for a, b in arcs if a == shape.names[i]} == {shape.names[h]}}
         self.incumbent = ticks(incumbent)
+        self.ticks = ticks
         self.switch = self._least_switch()
         self.farthest = max((value for (r, *_), value in self.travel.items()
                              if r not in limited), default=0)
@@ -271,7 +281,7 @@ class _Search:
             where[n] == (p, i) for n, robot in enumerate(self.limited)
             if robot in choice.limited)
 
-    def run(self, layouts, deadline) -> Fraction:
+    def run(self, layouts, deadline, stop=None, improved=None) -> Fraction:
         """The least makespan of the relaxation over `layouts` (per panel, its shape), or the
         least value still open when the deadline comes (a lower bound either way); the
         incumbent when no order ends before it."""
@@ -300,9 +310,13 @@ class _Search:
         expansions = 0
         while self.frontier:
             expansions += 1
-            if expansions % 512 == 0 and (time.monotonic() > deadline
-                                          or len(self.frontier) > MAX_OPEN):
-                return Fraction(self.frontier[0][0], self.scale)
+            if expansions % 512 == 0:
+                if time.monotonic() > deadline or len(self.frontier) > MAX_OPEN or (
+                        stop is not None and stop.is_set()):
+                    return Fraction(self.frontier[0][0], self.scale)
+                shorter = improved() if improved is not None else None
+                if shorter is not None:
+                    self.incumbent = min(self.incumbent, self.ticks(shorter))
             value, _, state, now, latest, ends, light_ends, free = heapq.heappop(self.frontier)
             layout, progress, last, where, recent, *_ = state
             shapes = layouts[layout]

@@ -19,6 +19,7 @@ from fjsp_planner.core.machine_bound import EVERY_JOB_LIMIT, panel_machine_bound
 from fjsp_planner.core.panels import stitched_schedule
 from fjsp_planner.core.problem import Problem
 from fjsp_planner.core.schedule import Result, Schedule, Status
+from fjsp_planner.core.sequence_bound import MAX_PANELS as SEQUENCE_PANELS
 from fjsp_planner.core.sequence_bound import panel_sequence_bound
 from fjsp_planner.core.validate import validate
 
@@ -33,13 +34,10 @@ PANEL_SHARE = 0.1
 start stitched from their optima (`panels.stitched_schedule`) and the bound of one panel done
 without the robots that cannot move between panels (`bounds.unhelped_panel`)."""
 MACHINE_SHARE = 0.1
-"""Share of the time limit for the panel sequence bound (`sequence_bound`), then, with what it
-leaves, the panel machine bound (`machine_bound`), which has at most half of the share when
-it does not keep every job (above `machine_bound.EVERY_JOB_LIMIT`). The sequence bound ends
-at once on 2 panels of the paper, where the machine bound is solved to its optimum (91 1/3)
-in about 3 s; from 3 panels on it proves more (3 panels: 146 1/3 in 0.15 s, where the
-machine bound reaches about 126 in 6 s; 5 panels: 235 in 6 s, the machine bound about 190),
-and on 5 it takes the whole share; above 6 panels it does not apply."""
+"""Share of the time limit for the panel machine bound (`machine_bound`) when it keeps every
+job (up to `machine_bound.EVERY_JOB_LIMIT`: on 2 panels of the paper it is solved to its
+optimum, 91 1/3, in about 3 s), half of it when it does not and the panel sequence bound
+(`sequence_bound`, which runs beside it and the search) does not apply."""
 LOAD_SHARE = 0.05
 """Share of the time limit for the panel load bound (`load_bound`): it proves the loads alone
 on 2 to 10 panels of the paper in 0.1-2 s (2 workers), then counts waits for the rest."""
@@ -97,7 +95,7 @@ def solve(problem: Problem, solver: str = 'cpsat', time_limit: float = 10.0, wor
         elapsed = time.monotonic() - began
         return Result(Status.FEASIBLE, greedy.makespan, critical_path_bound(problem), elapsed,
                       greedy, 'greedy', first_solution_seconds=elapsed)
-    panel_bound = None
+    panel_bound = sequence = handle = None
     if solver == 'cpsat' and greedy is not None and len(problem.panels) >= 2 and (
             not problem.fixed) and PANEL_SHARE * time_limit >= MIN_PANEL_SECONDS:
         stitched, panel_bound = stitched_schedule(problem, greedy.makespan,
@@ -106,29 +104,35 @@ def solve(problem: Problem, solver: str = 'cpsat', time_limit: float = 10.0, wor
             hint, notes = stitched, notes + ('started from panels stitched from one-panel '
                                              'optima',)
         incumbent = (hint or greedy).makespan
+        handle = SearchHandle()
+        sequence = _SequenceBeside(problem, incumbent, began + time_limit, handle)
         share = MACHINE_SHARE * time_limit
-        sequence_began = time.monotonic()
-        sequence = panel_sequence_bound(problem, incumbent, share)
-        left = min(share - (time.monotonic() - sequence_began),
-                   share / 2 if len(problem.jobs) > EVERY_JOB_LIMIT else share)
-        machine = (panel_machine_bound(problem, incumbent, left, workers)
-                   if left >= MIN_PANEL_SECONDS else None)
+        if len(problem.jobs) > EVERY_JOB_LIMIT:
+            # The sequence bound, where it applies, proves more (3 panels: 146 1/3 to 126).
+            share = share / 2 if len(problem.panels) > SEQUENCE_PANELS else 0
+        machine = (panel_machine_bound(problem, incumbent, share, workers)
+                   if share >= MIN_PANEL_SECONDS else None)
         load = panel_load_bound(problem, incumbent, LOAD_SHARE * time_limit, workers)
-        panel_bound = max((b for b in (panel_bound, sequence, machine, load) if b is not None),
+        panel_bound = max((b for b in (panel_bound, machine, load) if b is not None),
                           default=None)
-    if solver == 'cpsat' and hint is None and keep is None and greedy is not None and (
-            tabu.applies(problem)):
-        return _classic(problem, greedy, began, time_limit, workers, notes, log)
-    setup = time.monotonic() - began
-    remaining = max(0.05, time_limit - setup)
-    if solver == 'mip':
-        from fjsp_planner.core.mip import solve_mip
+    try:
+        if solver == 'cpsat' and hint is None and keep is None and greedy is not None and (
+                tabu.applies(problem)):
+            return _classic(problem, greedy, began, time_limit, workers, notes, log)
+        setup = time.monotonic() - began
+        remaining = max(0.05, time_limit - setup)
+        if solver == 'mip':
+            from fjsp_planner.core.mip import solve_mip
 
-        result = solve_mip(problem, remaining, backend=mip_backend, workers=workers,
-                           hint=hint or greedy, log=log)
-    else:
-        result = solve_cpsat(problem, remaining, workers, hint=hint, keep=keep,
-                             upper_bound=hint or greedy, log=log)
+            result = solve_mip(problem, remaining, backend=mip_backend, workers=workers,
+                               hint=hint or greedy, log=log)
+        else:
+            result = solve_cpsat(problem, remaining, workers, hint=hint, keep=keep,
+                                 upper_bound=hint or greedy, log=log, handle=handle)
+    finally:
+        found = sequence.result() if sequence is not None else None
+    if found is not None:
+        panel_bound = max(found, panel_bound or found)
     start = hint or greedy
     if result.schedule is None and start is not None and result.status != Status.INFEASIBLE:
         # The start is the shorter of the (valid) hint and the greedy schedule.
@@ -188,6 +192,37 @@ def _classic(problem: Problem, greedy: Schedule, began: float, time_limit: float
                   best.makespan, bound, time.monotonic() - began, best, solver,
                   first_solution_seconds=greedy_seconds, best_solution_seconds=best_at - began,
                   notes=notes + results[-1].notes)
+
+
+class _SequenceBeside:
+    """The panel sequence bound (`sequence_bound`) in a thread of its own, beside the
+    search, from the start's makespan `incumbent` (then each shorter one `handle` reports)
+    until `deadline` or until its result is asked for. Its search is pure Python: on 5
+    panels it runs for most of the limit on about a third of 2 cores, where before the
+    search it had a tenth of the limit to itself."""
+
+    def __init__(self, problem, incumbent, deadline, handle):
+        self._stop = threading.Event()
+        self._outcome = {}
+
+        def work():
+            try:
+                self._outcome['bound'] = panel_sequence_bound(
+                    problem, incumbent, max(0.0, deadline - time.monotonic()), self._stop,
+                    lambda: handle.best)
+            except BaseException as error:  # re-raised in the caller's thread
+                self._outcome['error'] = error
+
+        self._thread = threading.Thread(target=work, name='sequence-bound', daemon=True)
+        self._thread.start()
+
+    def result(self) -> Fraction | None:
+        """Stop the search and return its bound (None where it does not apply)."""
+        self._stop.set()
+        self._thread.join()
+        if 'error' in self._outcome:
+            raise self._outcome['error']
+        return self._outcome['bound']
 
 
 class _Background:
