@@ -378,8 +378,7 @@ class _Search:
                     begin = max(begin, free[g] + self.leave[robot, at[g], k, name])
         if last is not None:
             p, i, last_choice = last
-            if choice.heavy or not eager and all(
-                    x & y for x in last_choice.sets for y in choice.sets):
+            if choice.heavy or not eager and self._clash(last_choice, choice):
                 begin = max(begin, now + self._gap_between(shapes, last, (k, j, choice)))
             if p == k and (eager and not choice.heavy or (i, j) in shape.lags):
                 begin = max(begin, now + shape.lags.get((i, j), 0))

@@ -194,6 +194,32 @@ def _classic(problem: Problem, greedy: Schedule, began: float, time_limit: float
                   notes=notes + results[-1].notes)
 
 
+class _Thread:
+    """`work()` in a daemon thread of its own; `result()` waits for it and returns its value
+    or re-raises its error in the caller's thread."""
+
+    def __init__(self, name, work):
+        self._outcome = {}
+
+        def run():
+            try:
+                self._outcome['value'] = work()
+            except BaseException as error:  # re-raised in the caller's thread
+                self._outcome['error'] = error
+
+        self._thread = threading.Thread(target=run, name=name, daemon=True)
+        self._thread.start()
+
+    def done(self) -> bool:
+        return not self._thread.is_alive()
+
+    def result(self):
+        self._thread.join()
+        if 'error' in self._outcome:
+            raise self._outcome['error']
+        return self._outcome['value']
+
+
 class _SequenceBeside:
     """The panel sequence bound (`sequence_bound`) in a thread of its own, beside the
     search, from the start's makespan `incumbent` (then each shorter one `handle` reports)
@@ -203,26 +229,14 @@ class _SequenceBeside:
 
     def __init__(self, problem, incumbent, deadline, handle):
         self._stop = threading.Event()
-        self._outcome = {}
-
-        def work():
-            try:
-                self._outcome['bound'] = panel_sequence_bound(
-                    problem, incumbent, max(0.0, deadline - time.monotonic()), self._stop,
-                    lambda: handle.best)
-            except BaseException as error:  # re-raised in the caller's thread
-                self._outcome['error'] = error
-
-        self._thread = threading.Thread(target=work, name='sequence-bound', daemon=True)
-        self._thread.start()
+        self._thread = _Thread('sequence-bound', lambda: panel_sequence_bound(
+            problem, incumbent, max(0.0, deadline - time.monotonic()), self._stop,
+            lambda: handle.best))
 
     def result(self) -> Fraction | None:
         """Stop the search and return its bound (None where it does not apply)."""
         self._stop.set()
-        self._thread.join()
-        if 'error' in self._outcome:
-            raise self._outcome['error']
-        return self._outcome['bound']
+        return self._thread.result()
 
 
 class _Background:
@@ -231,27 +245,15 @@ class _Background:
     def __init__(self, problem, deadline, workers, upper_bound, hint, log):
         self.handle = SearchHandle()
         self.started = time.monotonic()
-        self._outcome = {}
-
-        def work():
-            try:
-                self._outcome['result'] = solve_cpsat(
-                    problem, max(0.05, deadline - time.monotonic()), workers,
-                    hint=hint, upper_bound=upper_bound, log=log, handle=self.handle)
-            except BaseException as error:  # re-raised in the caller's thread
-                self._outcome['error'] = error
-
-        self._thread = threading.Thread(target=work, name='cpsat', daemon=True)
-        self._thread.start()
+        self._thread = _Thread('cpsat', lambda: solve_cpsat(
+            problem, max(0.05, deadline - time.monotonic()), workers, hint=hint,
+            upper_bound=upper_bound, log=log, handle=self.handle))
 
     def done(self) -> bool:
-        return not self._thread.is_alive()
+        return self._thread.done()
 
     def result(self) -> Result:
-        self._thread.join()
-        if 'error' in self._outcome:
-            raise self._outcome['error']
-        return self._outcome['result']
+        return self._thread.result()
 
 
 def _with_panel_bounds(problem: Problem, result: Result, found_before: Fraction | None
