@@ -89,9 +89,10 @@ TRACKED = 3
 """How many of a limited robot's last light jobs the state keeps, for heavy jobs to keep
 clear of: the paper's Assembler does three in a panel it helps without a heavy job
 between (`Ac`, `Jd`, `Ad`)."""
-MAX_OPEN = 500_000
-"""The search stops, with the least value still open, when it has this many orders open
-(about 750 MB with what it has closed): 5 panels of the paper reach it in about 19 s."""
+MAX_OPEN = 320_000
+"""When this many orders are open, the quarter of highest value is let go (about 430 MB in
+all with what the search has closed; 5 panels of the paper reach it in about 10 s): the
+bound then rises no further than the least of them, 255 on 5 panels of the paper."""
 
 
 def panel_sequence_bound(problem: Problem, incumbent: Fraction, time_limit: float,
@@ -181,6 +182,9 @@ class _Search:
             if r not in limited:
                 key = (r, q, k, b)
                 self.leave[key] = min(value, self.leave.get(key, value))
+        self.farthest_from = {}
+        for (r, q, _, _), value in self.leave.items():
+            self.farthest_from[r, q] = max(value, self.farthest_from.get((r, q), 0))
         for shape in (self.bare, self.helped):
             shape.rest = _rest_costs(shape, self.switch)
 
@@ -306,29 +310,39 @@ class _Search:
                 self.frontier.append((self._estimate_anew(shapes, progress, None, -1),
                                       next(self.counter), state, 0, 0, free, untracked, idle))
         heapq.heapify(self.frontier)
-        closed = {}
+        closed = self.closed = {}
         expansions = 0
+        let_go = self.incumbent
         while self.frontier:
             expansions += 1
             if expansions % 512 == 0:
-                if time.monotonic() > deadline or len(self.frontier) > MAX_OPEN or (
-                        stop is not None and stop.is_set()):
-                    return Fraction(self.frontier[0][0], self.scale)
+                if time.monotonic() > deadline or (stop is not None and stop.is_set()):
+                    return Fraction(min(self.frontier[0][0], let_go), self.scale)
+                if len(self.frontier) > MAX_OPEN:
+                    # The orders of highest value are let go: none of what follows them ends
+                    # before the least of them, which caps the bound, and the memory they
+                    # held lets the search go on raising the bound up to it.
+                    self.frontier.sort()
+                    kept = MAX_OPEN * 3 // 4
+                    let_go = min(let_go, self.frontier[kept][0])
+                    del self.frontier[kept:]
                 shorter = improved() if improved is not None else None
-                if shorter is not None:
-                    self.incumbent = min(self.incumbent, self.ticks(shorter))
+                if shorter is not None and self.ticks(shorter) < self.incumbent:
+                    self.incumbent = self.ticks(shorter)
+                    # What can no longer end before it would hold memory the search needs.
+                    self.frontier = [entry for entry in self.frontier
+                                     if entry[0] < self.incumbent]
+                    heapq.heapify(self.frontier)
             value, _, state, now, latest, ends, light_ends, free = heapq.heappop(self.frontier)
+            if value >= let_go:
+                return Fraction(let_go, self.scale)
             layout, progress, last, where, recent, *_ = state
             shapes = layouts[layout]
             if all(done == shape.full for done, shape in zip(progress, shapes, strict=True)):
                 # `_visits_left` let no order do a helped panel without a limited robot.
                 return Fraction(value, self.scale)
             labels = closed.setdefault(state, [])
-            if any(t <= now and m <= latest and all(a <= b for a, b in zip(e, ends, strict=True))
-                   and all(a <= b for x, y in zip(le, light_ends, strict=True)
-                           for a, b in zip(x, y, strict=True))
-                   and all(a <= b for a, b in zip(f, free, strict=True))
-                   for t, m, e, le, f in labels):
+            if _dominated(labels, now, latest, ends, light_ends, free):
                 continue
             labels.append((now, latest, ends, light_ends, free))
             node = (state, now, latest, ends, light_ends, free)
@@ -358,7 +372,7 @@ class _Search:
                             continue
                         begin = self._after_last(node, k, j, choice, eager=True)
                         self._place(node, k, j, choice, begin)
-        return Fraction(self.incumbent, self.scale)
+        return Fraction(min(self.incumbent, let_go), self.scale)
 
     def _after_last(self, node, k, j, choice, eager):
         """Earliest start of job j of panel k staffed by `choice` after the last heavy job
@@ -443,15 +457,25 @@ class _Search:
                 continue
             new_light, new_light_ends = self._still_near(new_light, new_light_ends, new_now)
             new_at, new_free = self._group_at(at, free, choice, k, end)
+            new_state = (layout, after, new_last, moved, new_recent, new_visited, new_light,
+                         new_at)
+            # Checked here as well as when taken: an order no better than one already
+            # continued would only hold memory until then.
+            closed = self.closed.get(new_state)
+            if closed and _dominated(closed, new_now, new_latest, new_ends, new_light_ends,
+                                     new_free):
+                continue
             heapq.heappush(self.frontier, (
                 bound, next(self.counter),
-                (layout, after, new_last, moved, new_recent, new_visited, new_light, new_at),
-                new_now, new_latest, new_ends, new_light_ends, new_free))
+                new_state, new_now, new_latest, new_ends, new_light_ends, new_free))
 
     def _group_at(self, at, free, choice, k, end):
         """(the panel of each robot of G's last heavy job, when known, and its end) once a
         job of panel k, staffed by `choice`, ends at `end`: a heavy job moves the robots all
-        its sets have there, and leaves unknown where those only some have are."""
+        its sets have there, and leaves unknown where those only some have are. A robot
+        that could reach any job from its panel by `end` holds up no heavy job to come (each
+        starts after `end`), so its panel is forgotten too: orders that differ only there
+        become one state."""
         if not choice.heavy:
             return at, free
         new_at, new_free = list(at), list(free)
@@ -460,6 +484,10 @@ class _Search:
                 new_at[g], new_free[g] = k, end
             elif robot in choice.anyone:
                 new_at[g] = None
+            if new_at[g] is not None and new_free[g] + self.farthest_from[robot, new_at[g]] <= end:
+                new_at[g] = None
+            if new_at[g] is None:
+                new_free[g] = 0
         return tuple(new_at), tuple(new_free)
 
     def _still_near(self, light, light_ends, now):
@@ -583,6 +611,8 @@ class _Search:
         """(each limited robot's last job, its end, the panels they have worked in, its
         light jobs kept and their ends) once job j of panel k, staffed by `choice`, ends at
         `end`. A heavy job ends what a robot's light jobs before it can hold up."""
+        if not choice.limited:
+            return where, ends, visited, light, light_ends
         moved, new_ends = list(where), list(ends)
         new_light, new_light_ends = list(light), list(light_ends)
         for n, robot in enumerate(self.limited):
@@ -673,6 +703,16 @@ class _Search:
         if last_panel is None:
             others -= 1  # the first heavy job is entered from no panel
         return left + max(others, 0) * self.switch + (tail or 0)
+
+
+def _dominated(labels, now, latest, ends, light_ends, free):
+    """Whether one of `labels` (times of orders in one state) is no later in any time than
+    the ones given, so that whatever follows the given order follows it no later."""
+    return any(t <= now and m <= latest and all(a <= b for a, b in zip(e, ends, strict=True))
+               and all(a <= b for x, y in zip(le, light_ends, strict=True)
+                       for a, b in zip(x, y, strict=True))
+               and all(a <= b for a, b in zip(f, free, strict=True))
+               for t, m, e, le, f in labels)
 
 
 class _Shape:
