@@ -555,6 +555,14 @@ class _Search:
                 for t, job in enumerate(jobs) if self._clash(job[2], heavy_choice)]
         if not clashing:
             return [way]
+        # Only one place can keep every time as it is: after the jobs that ended in time.
+        done = 0
+        while done < len(clashing) and mine[clashing[done][0]] + clashing[done][1] <= begin:
+            done += 1
+        end = begin + heavy_choice.duration
+        if all(not follows and mine[t] - jobs[t][2].duration >= end + back
+               for t, _, back, follows in clashing[done:]):
+            return [way]
         ways = []
         for split in range(len(clashing) + 1):
             if any(follows for *_, follows in clashing[split:]):
@@ -572,8 +580,6 @@ class _Search:
                         shapes, n, jobs[t - 1], jobs[t]))
                 moved[t] = max(mine[t], light_start + light_choice.duration)
                 new_latest = max(new_latest, moved[t] + shapes[q].tails[m])
-            if start == begin and moved == list(mine):
-                return [way]
             new_ends = ends[:n] + (moved[-1],) + ends[n + 1:]
             ways.append((start, now, new_latest, new_ends,
                          light_ends[:n] + (tuple(moved),) + light_ends[n + 1:]))
