@@ -59,8 +59,9 @@ and how much longer the job after it takes than its least).
 
 It forgets lags between jobs whose ends it does not keep, the ways of robots of G but from
 their last heavy jobs, and which robot of a set does what. Every schedule shorter than U is
-one of these orders, so the search's least value, or the least value still open when its
-time runs out, bounds every schedule shorter than U, and min(bound, U) bounds all. CP-SAT's
+one of these orders, so the search's least value, or the least value still open (or let
+go, `MAX_OPEN`) when its time runs out, bounds every schedule shorter than U, and min(bound,
+U) bounds all. CP-SAT's
 model of a similar relaxation (`machine_bound`), which knows no panel's place,
 proves about 200 on 5 panels of the paper in minutes.
 """
@@ -102,7 +103,7 @@ def panel_sequence_bound(problem: Problem, incumbent: Fraction, time_limit: floa
     """The bound of the module docstring, or None when it does not apply (fewer than two
     or more than MAX_PANELS panels, running jobs, no robot of G, no job kept or more than
     MAX_PANEL_JOBS of them in a panel). The search ends early, with the least value still
-    open, once `stop` is set; `improved` gives the makespan of a shorter schedule found
+    open or let go, once `stop` is set; `improved` gives the makespan of a shorter schedule found
     meanwhile, if any (orders that cannot end before it are then dropped too, and the
     bound holds below it)."""
     panels = len(problem.panels)
@@ -287,8 +288,9 @@ class _Search:
 
     def run(self, layouts, deadline, stop=None, improved=None) -> Fraction:
         """The least makespan of the relaxation over `layouts` (per panel, its shape), or the
-        least value still open when the deadline comes (a lower bound either way); the
-        incumbent when no order ends before it."""
+        least value still open or let go when the deadline comes or the search reaches the
+        orders let go (a lower bound either way); the incumbent when no order ends before
+        it."""
         self.layout_shapes = layouts
         self.helped_masks = [sum(1 << k for k, shape in enumerate(shapes) if shape is self.helped)
                              for shapes in layouts]
