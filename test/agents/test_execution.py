@@ -51,7 +51,8 @@ def test_job_waits_for_co_workers_and_predecessors():
          {'J1': {'B'}, 'J2': {'A', 'B'}})
     assert kinds(r.step(3)) == [(ARRIVED, 'J2', 0)]
     assert r.mode == RobotMode.WAITING
-    r.operation_done('B', 'J1', 3.0, 1)   # J1's only robot is done: J1 is complete at 3
+    r.operation_done('B', 'J1', 3.0, 1)   # J1's only robot is done
+    r.job_done('J1', 3.0, 1)              # and the planner declares J1 complete at 3
     assert r.step(3.5) == []              # B has not arrived yet
     r.arrived('B', 'J2', 3.25, 1)
     assert kinds(r.step(3.5)) == [(STARTED, 'J2', 3.25)]
@@ -61,6 +62,33 @@ def test_job_waits_for_co_workers_and_predecessors():
     r.job_done('J2', 6.0, 1)
     r.step(6.0)
     assert r.finished
+
+
+def test_a_completion_only_a_peer_reported_does_not_start_a_job():
+    """Seen in the soak test: D hauled J1 (the only robot on it) and reported it done, then
+    was killed before those reports reached the planner, which declared D offline and had J1
+    hauled again much later. A, whose J2 follows J1, had heard D's report and started J2 at
+    once: the planner's record then had J2 starting before J1 ended, and failed the
+    mission. A waits for the planner to declare J1 done, and starts J2 at J1's end."""
+    r = RobotExecution('A')
+    plan(r, 1, [task('J2', 4, 1, preds=['J1'], arrival=0)], {'J1': {'D'}, 'J2': {'A'}})
+    assert kinds(r.step(3)) == [(ARRIVED, 'J2', 0)]
+    r.operation_done('D', 'J1', 3.0, 1)
+    assert r.step(20) == [] and r.mode == RobotMode.WAITING
+    r.job_done('J1', 3.0, 1)
+    assert kinds(r.step(20)) == [(STARTED, 'J2', 3.0), (DONE, 'J2', 4.0)]
+
+
+def test_a_robot_goes_on_from_its_own_job_without_the_planner():
+    """Where A took part in the predecessor, its robots' reports are enough (A goes on with
+    the plan while the planner is cut off): J2 starts when A and B are both done with J1."""
+    r = RobotExecution('A')
+    plan(r, 1, [task('J1', 0, 1, end=2, co=['B']), task('J2', 2, 1, preds=['J1'])],
+         {'J1': {'A', 'B'}, 'J2': {'A'}})
+    r.arrived('B', 'J1', 0.0, 1)
+    assert kinds(r.step(1.5)) == [(ARRIVED, 'J1', 0), (STARTED, 'J1', 0), (DONE, 'J1', 1)]
+    r.operation_done('B', 'J1', 2.0, 1)
+    assert kinds(r.step(3.5)) == [(ARRIVED, 'J2', 2), (STARTED, 'J2', 2), (DONE, 'J2', 3)]
 
 
 def holder():

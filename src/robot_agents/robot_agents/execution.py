@@ -2,9 +2,10 @@
 
 The robot keeps logical time: an operation started at `s` ends at `s + duration`, a leg left
 at `d` arrives at `d + leg`, and a job starts when its last robot arrived and its last
-predecessor completed. Everyone derives those instants from the same reported facts, so the
-robots of a job start at the same schedule time even though each learns of the last arrival a
-few milliseconds apart. Wall-clock lateness shows up as a robot acting later than its logical
+predecessor completed (for a predecessor done by other robots only, once the planner declared
+it done, so that no robot acts on a completion the planner missed). Everyone derives those
+instants from the same reported facts, so the robots of a job start at the same schedule time
+even though each learns of the last arrival a few milliseconds apart. Wall-clock lateness shows up as a robot acting later than its logical
 time, never as a timeline that breaks the schedule's constraints. What the robot learns at
 `now` (a new plan, a recovery) cannot make it act before `now`.
 
@@ -501,7 +502,7 @@ class RobotExecution:
                 return None
             times.append(self._arrived[robot, task.job].time)
         for job in task.predecessors:
-            end = self._job_end(job)
+            end = self._predecessor_end(job)
             if end is None and job not in self._job_robots:
                 end = max((fact.time for (_, done), fact in self._operation_done.items()
                            if done == job), default=None)
@@ -511,6 +512,17 @@ class RobotExecution:
                 return None
             times.append(end)
         return max(times)
+
+    def _predecessor_end(self, job: str) -> float | None:
+        """When a predecessor completed, as far as this robot may act on it: a job it took
+        part in when every robot on it reported done, another robot's job only when the
+        planner declared it done. A report that reached this robot but never the planner
+        (its robot killed before its writer was matched to the planner's reader) would
+        otherwise start this job on a completion the planner does not know of: it re-plans
+        the predecessor, and its record of the mission has this job starting first."""
+        if self.robot in self._job_robots.get(job, ()):
+            return self._job_end(job)
+        return self._job_done[job].time if job in self._job_done else None
 
     def _job_end(self, job: str) -> float | None:
         """A job is complete when the planner says so or every robot on it reported done."""
