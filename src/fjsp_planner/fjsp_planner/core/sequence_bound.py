@@ -55,7 +55,9 @@ the panels they have worked in and their light jobs kept, the panel of each robo
 last heavy job), with an estimate of what is left that never overstates it (the least
 durations of the jobs only heavy staffings can do, the lags or switches between them and one
 switch into each panel left but the first one entered, a switch costing at least its travel
-and how much longer the job after it takes than its least).
+and how much longer the job after it takes than its least). An order's value is the largest
+of its latest end plus tail, its last heavy end plus that estimate, and the limited robots'
+least way to the panels of its layout they have yet to work in.
 
 It forgets lags between jobs whose ends it does not keep, the ways of robots of G but from
 their last heavy jobs, and which robot of a set does what. Every schedule shorter than U is
@@ -308,9 +310,11 @@ class _Search:
             progress = tuple(0 for _ in shapes)
             state = (layout, progress, None, nobody, None, 0, untracked, nowhere)
             free = tuple(0 for _ in nobody)
-            if self._visits_left(layout, progress, nobody, free, 0) < self.incumbent:
-                self.frontier.append((self._estimate_anew(shapes, progress, None, -1),
-                                      next(self.counter), state, 0, 0, free, untracked, idle))
+            value = max(self._visits_left(layout, progress, nobody, free, 0),
+                        self._estimate_anew(shapes, progress, None, -1))
+            if value < self.incumbent:
+                self.frontier.append((value, next(self.counter), state, 0, 0, free, untracked,
+                                      idle))
         heapq.heapify(self.frontier)
         closed = self.closed = {}
         expansions = 0
@@ -454,8 +458,10 @@ class _Search:
                 new_now, new_last, new_recent = now, last, (k, j)
                 bound = max(new_latest, now + self._estimate(
                     layout, after, last[0] if last else None, last[1] if last else -1))
-            if bound >= self.incumbent or self._visits_left(
-                    layout, after, moved, new_ends, new_visited) >= self.incumbent:
+            if bound >= self.incumbent:
+                continue
+            bound = max(bound, self._visits_left(layout, after, moved, new_ends, new_visited))
+            if bound >= self.incumbent:
                 continue
             new_light, new_light_ends = self._still_near(new_light, new_light_ends, new_now)
             new_at, new_free = self._group_at(at, free, choice, k, end)
