@@ -5,9 +5,10 @@ at `d` arrives at `d + leg`, and a job starts when its last robot arrived and it
 predecessor completed (for a predecessor done by other robots only, once the planner declared
 it done, so that no robot acts on a completion the planner missed). Everyone derives those
 instants from the same reported facts, so the robots of a job start at the same schedule time
-even though each learns of the last arrival a few milliseconds apart. Wall-clock lateness shows up as a robot acting later than its logical
-time, never as a timeline that breaks the schedule's constraints. What the robot learns at
-`now` (a new plan, a recovery) cannot make it act before `now`.
+even though each learns of the last arrival a few milliseconds apart. Wall-clock lateness
+shows up as a robot acting later than its logical time, never as a timeline that breaks the
+schedule's constraints. What the robot learns at `now` (a new plan, a recovery) cannot make
+it act before `now`.
 
 Every fact carries the plan revision it was reported under. A revision that restarts a job
 (its task is not `continued`) voids what older revisions reported about it: the job is redone
