@@ -180,6 +180,18 @@ def test_sequence_bound_on_the_paper_three_panels_stays_proven_when_it_lets_orde
     assert 140 <= found <= Fraction(439, 3)
 
 
+def test_sequence_bound_counts_the_assemblers_way_to_its_panels_in_every_order(monkeypatch):
+    """4 panels of the paper, from the best known schedule, 217 1/2, with room for 8 open
+    orders: the search soon lets orders go, and its bound is the least value of those. Each
+    order's value counts the Assembler's least way to the panels its layout has it work in
+    and it has not yet (it crosses between neighbours in 200), so the orders where its
+    second panel is still ahead are not let go low: 201, where it was 160 1/6 when that way
+    only dropped orders that could not end before the known schedule."""
+    monkeypatch.setattr(sequence_bound, 'MAX_OPEN', 8)
+    problem = load_scenario(PAPER, panels=4)
+    assert 200 <= panel_sequence_bound(problem, Fraction(435, 2), 60) <= Fraction(435, 2)
+
+
 def test_sequence_bound_walks_a_limited_robot_to_its_second_panel():
     """The paper's 3 panels with an Assembler that crosses in 150 (speed 40): within 150 it
     may work in two neighbouring panels, but only reaches the second after 150, so the
