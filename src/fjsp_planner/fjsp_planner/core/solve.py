@@ -239,21 +239,15 @@ class _SequenceBeside:
         return self._thread.result()
 
 
-class _Background:
+class _Background(_Thread):
     """`solve_cpsat` in a thread of its own until `deadline`, followed by a `SearchHandle`."""
 
     def __init__(self, problem, deadline, workers, upper_bound, hint, log):
         self.handle = SearchHandle()
         self.started = time.monotonic()
-        self._thread = _Thread('cpsat', lambda: solve_cpsat(
+        super().__init__('cpsat', lambda: solve_cpsat(
             problem, max(0.05, deadline - time.monotonic()), workers, hint=hint,
             upper_bound=upper_bound, log=log, handle=self.handle))
-
-    def done(self) -> bool:
-        return self._thread.done()
-
-    def result(self) -> Result:
-        return self._thread.result()
 
 
 def _with_panel_bounds(problem: Problem, result: Result, found_before: Fraction | None
