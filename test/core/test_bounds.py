@@ -192,6 +192,21 @@ def test_sequence_bound_counts_the_assemblers_way_to_its_panels_in_every_order(m
     assert 200 <= panel_sequence_bound(problem, Fraction(435, 2), 60) <= Fraction(435, 2)
 
 
+def test_sequence_bound_sends_the_assembler_no_earlier_than_the_heavy_jobs_it_waits_for(
+        monkeypatch):
+    """5 panels of the paper, from the best known schedule, 282 2/3, with room for 8 open
+    orders, as above. In a layout of two panels, an order where LSMS and the MARCs have
+    done much elsewhere while `Aa` and `Ab` of the Assembler's first panel are still ahead
+    cannot send it there before they end: every job it can do there waits for one of them
+    (`Ac`, `Jd`, `Ad`) or holds into one (`Ja`, `Jb`), and they come after the last heavy
+    job. Then it crosses, 200. Counting that in the Assembler's way lets those orders go
+    no lower than 227, where they went at 218 when its way started from the heads of the
+    jobs alone."""
+    monkeypatch.setattr(sequence_bound, 'MAX_OPEN', 8)
+    problem = load_scenario(PAPER, panels=5)
+    assert 225 <= panel_sequence_bound(problem, Fraction(848, 3), 60) <= Fraction(848, 3)
+
+
 def test_sequence_bound_walks_a_limited_robot_to_its_second_panel():
     """The paper's 3 panels with an Assembler that crosses in 150 (speed 40): within 150 it
     may work in two neighbouring panels, but only reaches the second after 150, so the

@@ -46,13 +46,15 @@ of their limits; in the other panels the kept jobs are staffed from G. The searc
 such set on its own (its *layout*): a limited robot works in each of its panels, so an order
 in which one has not yet is no shorter than the least way of a limited robot from its last
 job to a job left there and that job's tail (for two such panels, of one robot through both
-or two robots; panels a robot cannot reach in time rule the layout out), and an order that
-does every job of such a panel without one belongs to another layout. Its value is the least
-makespan over such orders, each job at its least duration for the robots chosen plus the
-least time after its end (its tail), over every layout: a best-first search over (the
-layout, which jobs of each panel are done, the last heavy one, each limited robot's last one,
-the panels they have worked in and their light jobs kept, the panel of each robot of G's
-last heavy job), with an estimate of what is left that never overstates it (the least
+or two robots; panels a robot cannot reach in time rule the layout out; a job after a job
+only heavy staffings can do, not yet done, starts no earlier than that one's least end after
+the last heavy job, and a jig job keeps the robot until the job it holds into ends), and an
+order that does every job of such a panel without one belongs to another layout. Its value
+is the least makespan over such orders, each job at its least duration for the robots chosen
+plus the least time after its end (its tail), over every layout: a best-first search over
+(the layout, which jobs of each panel are done, the last heavy one, each limited robot's
+last one, the panels they have worked in and their light jobs kept, the panel of each robot
+of G's last heavy job), with an estimate of what is left that never overstates it (the least
 durations of the jobs only heavy staffings can do, the lags or switches between them and one
 switch into each panel left but the first one entered, a switch costing at least its travel
 and how much longer the job after it takes than its least). An order's value is the largest
@@ -194,7 +196,8 @@ class _Search:
     def _ways_of_limited(self):
         """What `_way` reads: per limited robot, from each job of a helped panel it could
         have done last (or from nowhere yet), to each job of a helped panel it can do
-        (bit, travel, head, least duration with it, tail); per set of jobs of a helped panel
+        (bit, travel, head, least duration with it, tail, the job, the job it holds into
+        and its least duration with it, if any); per set of jobs of a helped panel
         done and whether the tail counts, the least of those durations (plus tails) left;
         and its least travel between two panels."""
         self.crossing = {}
@@ -213,7 +216,9 @@ class _Search:
                 self.reach[n, at, k] = [
                     (1 << j, 0 if at is None else self.travel[
                         robot, at[0], shape.names[at[1]], k, shape.names[j]],
-                     shape.heads[j], durations[j][n], shape.tails[j]) for j in able]
+                     shape.heads[j], durations[j][n], shape.tails[j], j,
+                     shape.held.get(j), durations[shape.held[j]].get(n)
+                     if j in shape.held else None) for j in able]
             for last in (False, True):
                 self.least_with[n, last] = [
                     min((durations[j][n] + (shape.tails[j] if last else 0) for j in able
@@ -301,7 +306,6 @@ class _Search:
         self.gaps = {}
         self.clashes = {}
         self.clashing = {}
-        self.first_steps = {}
         nobody = tuple(None for _ in self.limited)
         untracked = tuple(() for _ in self.limited)
         nowhere = tuple(None for _ in self.group)
@@ -310,7 +314,7 @@ class _Search:
             progress = tuple(0 for _ in shapes)
             state = (layout, progress, None, nobody, None, 0, untracked, nowhere)
             free = tuple(0 for _ in nobody)
-            value = max(self._visits_left(layout, progress, nobody, free, 0),
+            value = max(self._visits_left(layout, progress, nobody, free, 0, 0),
                         self._estimate_anew(shapes, progress, None, -1))
             if value < self.incumbent:
                 self.frontier.append((value, next(self.counter), state, 0, 0, free, untracked,
@@ -460,7 +464,8 @@ class _Search:
                     layout, after, last[0] if last else None, last[1] if last else -1))
             if bound >= self.incumbent:
                 continue
-            bound = max(bound, self._visits_left(layout, after, moved, new_ends, new_visited))
+            bound = max(bound, self._visits_left(layout, after, moved, new_ends, new_visited,
+                                                 new_now))
             if bound >= self.incumbent:
                 continue
             new_light, new_light_ends = self._still_near(new_light, new_light_ends, new_now)
@@ -640,7 +645,7 @@ class _Search:
         return (tuple(moved), tuple(new_ends), visited | (1 << k if choice.limited else 0),
                 tuple(new_light), tuple(new_light_ends))
 
-    def _visits_left(self, layout, progress, where, ends, visited):
+    def _visits_left(self, layout, progress, where, ends, visited, now):
         """The least makespan for the limited robots to work in each of the layout's helped
         panels where none has worked yet, after their last jobs: each such panel needs one
         of them there, and each two such panels one robot going on from one to the other
@@ -654,7 +659,7 @@ class _Search:
         robots = range(len(self.limited))
 
         def way(n, order):
-            return self._way(shapes, progress, n, where[n], ends[n], order)
+            return self._way(shapes, progress, n, where[n], ends[n], order, now)
 
         alone = {k: [way(n, (k,)) for n in robots] for k in left}
         latest = max(min(ways) for ways in alone.values())
@@ -665,7 +670,7 @@ class _Search:
             latest = max(latest, both)
         return latest
 
-    def _way(self, shapes, progress, n, at, free, order):
+    def _way(self, shapes, progress, n, at, free, order, now):
         """The least end of limited robot n's way from its last job `at`, free from `free`,
         through a job left in each panel of `order` in turn, with the last one's tail."""
         time = None
@@ -673,13 +678,7 @@ class _Search:
             done = progress[k]
             last = step == len(order) - 1
             if step == 0:
-                key = (n, at, free, k, done, last)
-                least = self.first_steps.get(key, False)
-                if least is False:
-                    least = self.first_steps[key] = min(
-                        (max(free + travel, head) + duration + (tail if last else 0)
-                         for bit, travel, head, duration, tail in self.reach[n, at, k]
-                         if not done & bit), default=None)
+                least = self._first_step(shapes[k], n, at, free, k, done, last, now)
             else:
                 least = self.least_with[n, last][done]
                 if least is not None:
@@ -688,6 +687,30 @@ class _Search:
                 return self.incumbent
             time = least
         return time
+
+    def _first_step(self, shape, n, at, free, k, done, last, now):
+        """The least end (with its tail when `last`) of limited robot n's next job in panel
+        k, from its last job `at`, free from `free`, once the order's last heavy job ends at
+        `now`: a job after a heavy-only one not yet done starts no earlier than that one's
+        least end after `now` and the lag between them, and a jig job keeps the robot until
+        the job it holds into ends."""
+        pending = shape.pending[done]
+        least = None
+        for bit, travel, head, duration, tail, j, held, held_duration in self.reach[n, at, k]:
+            if done & bit:
+                continue
+            start = max(free + travel, head)
+            if pending[j] is not None:
+                start = max(start, now + pending[j])
+            end = start + duration + (tail if last else 0)
+            if held_duration is not None:
+                held_start = shape.heads[held]
+                if pending[held] is not None:
+                    held_start = max(held_start, now + pending[held])
+                end = max(end, held_start + held_duration + (shape.tails[held] if last else 0))
+            if least is None or end < least:
+                least = end
+        return least
 
     def _estimate(self, layout, progress, last_panel, last_job):
         """What is left after the last heavy job (job `last_job` of panel `last_panel`, or
@@ -757,7 +780,26 @@ class _Shape:
         self.left = [sum(self.least[j] for j in left) for left in heavy_left]
         self.least_tail = [min((self.tails[j] for j in left), default=0)
                            for left in heavy_left]
+        self.pending = [[self._pending(done, x) for x in range(count)]
+                        for done in range(self.full + 1)]
         self.rest = {}
+
+    def _pending(self, done, x):
+        """With the jobs `done` done, the least time from the end of the last heavy job
+        to the start of job x that the heavy-only jobs not done before it, or x itself,
+        need (each starts after that end), or None."""
+        found = None
+        for a in range(len(self.names)):
+            if done >> a & 1 or not self.always_heavy[a]:
+                continue
+            if a == x:
+                gap = 0
+            elif (a, x) in self.lags:
+                gap = self.least[a] + self.lags[a, x]
+            else:
+                continue
+            found = gap if found is None else max(found, gap)
+        return found
 
 
 class _Choice:
