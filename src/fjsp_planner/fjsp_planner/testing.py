@@ -27,6 +27,7 @@ import dataclasses
 import fcntl
 import math
 import random
+import signal
 import subprocess
 import tempfile
 import time
@@ -241,8 +242,18 @@ class FleetHarness(Fleet):
         self.network.restore(self.host_of(node))
 
     def wait_for(self, predicate, timeout: float, what: str = 'a condition') -> None:
-        """`Observer.wait_for`: `predicate` gets the observer."""
-        self.observer.wait_for(predicate, timeout, what)
+        """`Observer.wait_for`: `predicate` gets the observer. Should the wait time out,
+        the failure also names the nodes that are no longer running and how they ended: a
+        node that crashed, or never came back after a restart, is often why."""
+        try:
+            self.observer.wait_for(predicate, timeout, what)
+        except pytest.fail.Exception as failure:
+            ended = self.exited()
+            if not ended:
+                raise
+            pytest.fail(f'{failure}; not running: ' + ', '.join(
+                f'{name} ({_how_it_ended(code)})' for name, code in sorted(ended.items())),
+                pytrace=False)
 
     def inject_fault(self, robot: str, fault: str, factor: float | None = None,
                      timeout: float = 10.0) -> str:
@@ -335,6 +346,15 @@ def pytest_collection_modifyitems(items) -> None:
     LAN whose bridge came after any other test's participant in this process announces only
     addresses the LAN's hosts cannot reach, and hears nothing."""
     items.sort(key=lambda item: 'fjsp_network' not in getattr(item, 'fixturenames', ()))
+
+
+def _how_it_ended(code: int) -> str:
+    if code < 0:
+        try:
+            return f'killed by {signal.Signals(-code).name}'
+        except ValueError:
+            return f'killed by signal {-code}'
+    return f'exited with {code}'
 
 
 @pytest.fixture
