@@ -195,17 +195,19 @@ class _Search:
             shape.rest = _rest_costs(shape, self.switch)
 
     def _ways_of_limited(self):
-        """What `_way` reads: per limited robot, from each job of a helped panel it could
-        have done last (or from nowhere yet), to each job of a helped panel it can do
-        (bit, travel, head, least duration with it, tail, the job, the job it holds into
-        and its least duration with it, if any); per set of jobs of a helped panel
-        done and whether the tail counts, the least of those durations (plus tails) left;
-        and its least travel between two panels."""
+        """What `_way` and `_first_step` read: per limited robot, from each job of a helped
+        panel it could have done last (or from nowhere yet), to each job of a helped panel
+        it can do (bit, travel, head, least duration with it, tail, the job, the job it
+        holds into and its least duration with it, if any); per set of jobs of a helped
+        panel done, `pending` of each job; per set of jobs of a helped panel done and
+        whether the tail counts, the least of those durations (plus tails) left; and its
+        least travel between two panels."""
         self.crossing = {}
         for (r, k, _, m, _), value in self.travel.items():
             if r in self.limited and k != m:
                 self.crossing[r, k, m] = min(value, self.crossing.get((r, k, m), value))
         shape = self.helped
+        self.pending = _pending(shape)
         durations = [{n: min(c.duration for c in choices if robot in c.limited)
                       for n, robot in enumerate(self.limited)
                       if any(robot in c.limited for c in choices)} for choices in shape.choices]
@@ -679,7 +681,7 @@ class _Search:
             done = progress[k]
             last = step == len(order) - 1
             if step == 0:
-                least = self._first_step(shapes[k], n, at, free, k, done, last, now)
+                least = self._first_step(n, at, free, k, done, last, now)
             else:
                 least = self.least_with[n, last][done]
                 if least is not None:
@@ -689,13 +691,13 @@ class _Search:
             time = least
         return time
 
-    def _first_step(self, shape, n, at, free, k, done, last, now):
+    def _first_step(self, n, at, free, k, done, last, now):
         """The least end (with its tail when `last`) of limited robot n's next job in panel
         k, from its last job `at`, free from `free`, once the order's last heavy job ends at
         `now`: a job after a heavy-only one not yet done starts no earlier than that one's
         least end after `now` and the lag between them, and a jig job keeps the robot until
-        the job it holds into ends."""
-        pending = shape.pending[done]
+        the job it holds into ends (panel k is a helped one)."""
+        shape, pending = self.helped, self.pending[done]
         least = None
         for bit, travel, head, duration, tail, j, held, held_duration in self.reach[n, at, k]:
             if done & bit:
@@ -781,26 +783,7 @@ class _Shape:
         self.left = [sum(self.least[j] for j in left) for left in heavy_left]
         self.least_tail = [min((self.tails[j] for j in left), default=0)
                            for left in heavy_left]
-        self.pending = [[self._pending(done, x) for x in range(count)]
-                        for done in range(self.full + 1)]
         self.rest = {}
-
-    def _pending(self, done, x):
-        """With the jobs `done` done, the least time from the end of the last heavy job
-        to the start of job x that the heavy-only jobs not done before it, or x itself,
-        need (each starts after that end), or None."""
-        found = None
-        for a in range(len(self.names)):
-            if done >> a & 1 or not self.always_heavy[a]:
-                continue
-            if a == x:
-                gap = 0
-            elif (a, x) in self.lags:
-                gap = self.least[a] + self.lags[a, x]
-            else:
-                continue
-            found = gap if found is None else max(found, gap)
-        return found
 
 
 class _Choice:
@@ -808,6 +791,22 @@ class _Choice:
         self.duration, self.sets, self.heavy, self.limited = duration, sets, heavy, limited
         self.always = frozenset.intersection(*map(frozenset, sets))
         self.anyone = frozenset.union(*map(frozenset, sets))
+
+
+def _pending(shape):
+    """(jobs done) -> per job x, the least time from the end of the last heavy job to the
+    start of x that the jobs only heavy staffings can do, not done, before x or x itself
+    need (each starts after that end), or None when there is none."""
+    heavy = [a for a in range(len(shape.names)) if shape.always_heavy[a]]
+    table = []
+    for done in range(shape.full + 1):
+        row = []
+        for x in range(len(shape.names)):
+            gaps = [0 if a == x else shape.least[a] + shape.lags[a, x] for a in heavy
+                    if not done >> a & 1 and (a == x or (a, x) in shape.lags)]
+            row.append(max(gaps) if gaps else None)
+        table.append(row)
+    return table
 
 
 def _rest_costs(shape, switch):
