@@ -20,10 +20,13 @@ def task(job, start, duration, end=None, leg=0.0, co=(), preds=(), held=False, l
                 predecessors=tuple(preds), held_into_next=held)
 
 
-def plan(r, revision, tasks, job_robots=None, now=0.0, continued=()):
-    """Give robot `r` a revision; by default it does every job alone."""
+def plan(r, revision, tasks, job_robots=None, now=0.0, continued=(), restarted_in=None):
+    """Give robot `r` a revision; by default it does every job alone, and a continued job
+    was last started afresh in revision 1."""
     job_robots = job_robots if job_robots is not None else {t.job: {r.robot} for t in tasks}
-    r.set_plan(revision, tasks, job_robots, now, continued=continued)
+    if restarted_in is None:
+        restarted_in = {job: revision if job not in continued else 1 for job in job_robots}
+    r.set_plan(revision, tasks, job_robots, now, restarted_in=restarted_in)
 
 
 def kinds(events):
@@ -326,6 +329,23 @@ def test_restarted_job_drops_stale_facts_and_ignores_late_ones():
     assert r.step(5) == []
     assert r.arrived('B', 'J2', 4.0, 2)
     assert kinds(r.step(5)) == [(STARTED, 'J2', 4)]   # J1's completion still counts
+
+
+def test_a_missed_revision_that_restarted_a_job_still_voids_its_old_facts():
+    r = RobotExecution('A')
+    jobs = {'J2': {'A', 'B'}}
+    plan(r, 1, [task('J2', 0, 2, co=['B'])], jobs)
+    r.step(0)
+    r.arrived('B', 'J2', 1.0, 1)
+    # A never got revision 2, which restarted J2; revision 3 keeps J2 as revision 2 had it.
+    plan(r, 3, [task('J2', 4, 2, co=['B'])], jobs, now=3, continued={'J2'},
+         restarted_in={'J2': 2})
+    assert attempts(r.step(3)) == [(ARRIVED, 'J2', 2)]   # A redoes its part of J2
+    assert r.mode == RobotMode.WAITING          # B's arrival of revision 1 no longer counts
+    assert not r.arrived('B', 'J2', 1.5, 1)   # nor does a late one
+    assert r.step(5) == []
+    assert r.arrived('B', 'J2', 4.0, 2)
+    assert kinds(r.step(5)) == [(STARTED, 'J2', 4)]
 
 
 def test_report_of_the_new_revision_before_this_robot_follows_it():

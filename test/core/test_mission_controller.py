@@ -491,6 +491,11 @@ def test_a_job_its_robots_reached_goes_on_when_the_new_plan_keeps_it(problem):
     assert 'Inspect' in published.result.schedule.jobs
     assert job in published.continued
     assert published.revision == 2
+    # An agent that missed revision 1 still knows which reports about each job count.
+    assert published.restarted_in[job] == 1
+    assert published.restarted_in['Inspect'] == 2
+    assert all(published.restarted_in[name] == 2 for name in published.result.schedule.jobs
+               if name not in published.continued)
     for robot in assignment.robots:
         _, ignored = fleet.event(EventKind.STARTED, robot, job, float(assignment.start),
                                  revision=1)

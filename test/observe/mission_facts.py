@@ -39,11 +39,13 @@ def at(t: float) -> float:
 
 
 def task(robot, job, start, end, continued=False, held=False, co_workers=(),
-         predecessors=()):
+         predecessors=(), restarted_in=1):
+    """A task of a job that, when continued, was last started afresh in `restarted_in`."""
     return PlannedTask(robot=robot, job=job, operation='weld', location=f'at_{job}',
                        travel_start=start - 1, arrival=start, start=start, operation_end=end,
                        end=end, co_workers=tuple(co_workers), predecessors=tuple(predecessors),
-                       held_into_next=held, continued=continued)
+                       held_into_next=held, continued=continued,
+                       restarted_in=restarted_in if continued else 0)
 
 
 def plan(revision, published, tasks, reasons=(), mission=MISSION, makespan=10.0):
@@ -176,7 +178,8 @@ def as_message(fact) -> dict:
                      'travel_start': t.travel_start, 'arrival': t.arrival, 'start': t.start,
                      'operation_end': t.operation_end, 'end': t.end,
                      'co_workers': list(t.co_workers), 'predecessors': list(t.predecessors),
-                     'held_into_next': t.held_into_next, 'continued': t.continued}
+                     'held_into_next': t.held_into_next, 'continued': t.continued,
+                     'restarted_in': t.restarted_in}
                     for t in fact.tasks if t.robot == robot]} for robot, kind in fact.robots]}
     if isinstance(fact, TaskEventFact):
         return {'stamp': time(fact.stamp), 'event_id': fact.event_id,

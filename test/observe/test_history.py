@@ -153,6 +153,21 @@ def test_a_continued_job_keeps_its_attempt():
         'J1': [(1, Outcome.DONE, 1, 4, 4)]}
 
 
+def test_a_late_joiner_takes_a_restart_it_missed_from_the_plan_that_continues_it():
+    # Revision 2 restarted J1 and A arrived under it, revisions 3 and 4 kept J1 as it was, A
+    # started it under 3. A monitor that only got revision 4 still sees two attempts, not one
+    # (revision 2 unknown) nor three (a start under a revision it has no plan of).
+    facts = [plan(4, 6.5, [task('A', 'J1', 6, 8, continued=True, restarted_in=2)])]
+    facts += work(['A'], 'J1', 1, 1, 4, done=False)
+    facts += [event(EventKind.ARRIVED, 'A', 'J1', 2, 5),
+              event(EventKind.STARTED, 'A', 'J1', 3, 6),
+              event(EventKind.OPERATION_DONE, 'A', 'J1', 4, 8),
+              event(EventKind.JOB_DONE, '', 'J1', 4, 8)]
+    attempts = history_of(facts).missions[MISSION].attempts()
+    assert [(a.number, a.revision, a.start) for a in attempts] == [(1, 1, 1), (2, 2, 6)]
+    assert attempts[1].outcome == Outcome.DONE
+
+
 def test_the_planners_mission_events_decide_aborts_and_voids():
     facts = [plan(1, 0, [task('A', 'J1', 1, 2), task('A', 'J2', 3, 6)])]
     facts += work(['A'], 'J1', 1, 1, 2) + work(['A'], 'J2', 1, 3, 6, done=False)

@@ -395,13 +395,13 @@ def fjsp_fleet(tmp_path):
 
 def restart_revisions(plans) -> dict[str, int]:
     """Per job, the last plan revision that (re)started it: its reports under older ones are
-    void (`PlanTask.continued`)."""
+    void (`PlanTask.continued`, `PlanTask.restarted_in`)."""
     since = {}
     for plan in plans:
         for robot in plan.robots:
             for task in robot.tasks:
-                if not task.continued:
-                    since[task.job] = max(since.get(task.job, 0), plan.revision)
+                attempt = plan.revision if not task.continued else task.restarted_in
+                since[task.job] = max(since.get(task.job, 0), attempt)
     return since
 
 

@@ -171,12 +171,12 @@ class RobotAgent(Node):
         if self.time_scale and self.time_scale != msg.time_scale:
             log.warning(f'running at time_scale {self.time_scale} s/unit while the plan '
                         f'assumes {msg.time_scale}: this robot runs off the planned pace')
-        job_robots, continued = {}, set()
+        job_robots, restarted_in = {}, {}
         for robot_plan in msg.robots:
             for t in robot_plan.tasks:
                 job_robots.setdefault(t.job, set()).add(robot_plan.robot)
-                if t.continued:
-                    continued.add(t.job)
+                since = t.restarted_in if t.continued else msg.revision
+                restarted_in[t.job] = max(restarted_in.get(t.job, 0), since)
         tasks = [Task(job=t.job, operation_type=t.operation_type, location=t.location,
                       travel_start=t.travel_start, arrival=t.arrival, start=t.start,
                       operation_end=t.operation_end, end=t.end,
@@ -194,7 +194,7 @@ class RobotAgent(Node):
             # What was due before the new revision happened under the old one.
             self.publish_events(self.execution.step(now))
         self.execution.set_plan(msg.revision, tasks, job_robots, max(now, 0.0),
-                                continued=continued)
+                                restarted_in=restarted_in)
         log.info(f"following plan revision {msg.revision} of mission '{mission}': "
                  + (' -> '.join(t.job for t in tasks) or 'no task'))
         self.publish_state()  # a new revision is a transition, even before the mission start
@@ -231,7 +231,7 @@ class RobotAgent(Node):
         now = max(self.now_units(), 0.0)
         self.publish_events(self.execution.cancel(now, 'mission cancelled'))
         # The cancelling revision is followed like any other, so older ones stay stale.
-        self.execution.set_plan(msg.revision, (), {}, now, continued=())
+        self.execution.set_plan(msg.revision, (), {}, now, restarted_in={})
         self.get_logger().warning(f"mission '{shorten(msg.mission_id, 80)}' cancelled: "
                                   'tasks dropped')
         self.publish_state()

@@ -12,7 +12,9 @@ it act before `now`.
 
 Every fact carries the plan revision it was reported under. A revision that restarts a job
 (its task is not `continued`) voids what older revisions reported about it: the job is redone
-from scratch, so its old arrivals and completions must not start or end the new attempt.
+from scratch, so its old arrivals and completions must not start or end the new attempt. Each
+task also names the revision that last restarted its job (`restarted_in`), so a robot that
+missed that revision, and gets a later one continuing the job, voids the same facts.
 """
 
 import math
@@ -192,13 +194,16 @@ class RobotExecution:
 
     # --- plans -----------------------------------------------------------------------
 
-    def set_plan(self, revision: int, tasks, job_robots, now: float, *, continued) -> None:
+    def set_plan(self, revision: int, tasks, job_robots, now: float, *, restarted_in) -> None:
         """Follow a newer revision from `now`.
 
-        `job_robots` maps every job of the plan to its robots; `continued` names the jobs
-        that go on as they are. Every other job of the plan starts afresh: what older
-        revisions reported about it is dropped, and later reports of older revisions about it
-        are ignored. The robot goes on with its current job only if that job is continued and
+        `job_robots` maps every job of the plan to its robots; `restarted_in` maps a job to
+        the revision that last started it afresh: an older one for a job that goes on as it
+        is (continued), `revision` itself (the default) for a job that starts afresh. What
+        revisions older than that one reported about a job is dropped, and later reports of
+        theirs are ignored, whichever revisions in between this robot missed (it then redoes
+        its part of a job restarted in one of them).
+        The robot goes on with its current job only if that job is continued and
         is the first unfinished task of its new sequence; otherwise it ends the leg it is on
         (if any) and follows the new sequence from there, abandoning the job it was on without
         an event (the planner ordered it). A failed robot takes the revision but does nothing.
@@ -208,13 +213,17 @@ class RobotExecution:
             raise ValueError(f'plan revision {revision} is not newer than revision '
                              f'{self.revision} already followed')
         tasks = tuple(tasks)
-        continued = frozenset(continued)
         current = self.task
-        self.revision = revision
+        previous, self.revision = self.revision, revision
         self._job_robots = {job: frozenset(robots) for job, robots in job_robots.items()}
         self._not_before = max(self._not_before, now)
-        for job in (set(self._job_robots) | {t.job for t in tasks}) - continued:
-            self._restart(job, revision)
+        continued = set()
+        for job in set(self._job_robots) | {t.job for t in tasks}:
+            since = min(restarted_in.get(job, revision), revision)
+            if since <= previous:  # else restarted in a revision this robot missed
+                continued.add(job)
+            if since > self._restarted.get(job, 0):
+                self._restart(job, since)
         self.tasks = tasks
         if self._phase == _Phase.FAILED:
             self._index = 0

@@ -163,6 +163,9 @@ class PublishPlan:
     mission_start: float
     """Wall seconds of schedule time 0."""
     cancelled: bool = False
+    restarted_in: Mapping[str, int] = field(default_factory=dict)
+    """Per job of the plan, the revision that last started it afresh (this one for a job
+    not continued): a robot that missed that revision still knows which reports are void."""
     incarnations: Mapping[str, int] = field(default_factory=dict)
     """The agent incarnation each robot's tasks are planned for: the one it reported."""
     starts: Mapping[str, str | None] = field(default_factory=dict)
@@ -1013,8 +1016,10 @@ class MissionController:
         mission.state = MissionState.EXECUTING
         starts = {r.name: r.start_location for r in mission.problem.robots}
         incarnations = {name: planned[0] for name, planned in mission.planned.items()}
+        restarted_in = {job: tracker.jobs[job].since_revision for job in result.schedule.jobs}
         return [PublishPlan(revision, posed, result, continued, reasons, mission.start,
-                            incarnations=incarnations, starts=starts),
+                            restarted_in=restarted_in, incarnations=incarnations,
+                            starts=starts),
                 Note(MissionEventKind.PLAN_PUBLISHED, reasons)]
 
     def _next_revision(self, mission: _Mission) -> int:

@@ -14,11 +14,14 @@ def _float(value) -> float:
 
 def plan_msg(scenario: Problem, posed: Problem, schedule: Schedule, result: Result,
              mission_id: str, revision: int, mission_start, time_scale: float, stamp,
-             continued=frozenset(), reasons=(), incarnations=None) -> Plan:
+             restarted_in=None, reasons=(), incarnations=None) -> Plan:
     """The plan message of a schedule of `posed`: every robot's tasks with travel, times and
     partners. `posed` is the scenario itself, or what remained of it at a re-plan; every
     robot of the scenario is listed, the ones left out of `posed` with no task, each with
-    the agent incarnation its tasks are for (`incarnations`; 0 where not given)."""
+    the agent incarnation its tasks are for (`incarnations`; 0 where not given).
+    `restarted_in` maps a job to the revision that last started it afresh, `revision` (a
+    job not continued) where not given."""
+    restarted_in = restarted_in or {}
     holds = {(a, q): b for a, b, q in posed.holding}
     in_posed = {r.name for r in posed.robots}
     robots = []
@@ -42,7 +45,8 @@ def plan_msg(scenario: Problem, posed: Problem, schedule: Schedule, result: Resu
                 predecessors=_predecessors(scenario, posed, visit.job),
                 held_into_next=following is not None
                 and holds.get((visit.job, q)) == following,
-                continued=visit.job in continued))
+                continued=restarted_in.get(visit.job, revision) < revision,
+                restarted_in=min(restarted_in.get(visit.job, revision), revision)))
         robots.append(RobotPlan(robot=robot.name, robot_type=robot.type, tasks=tasks,
                                 incarnation=(incarnations or {}).get(robot.name, 0)))
     return Plan(stamp=stamp, mission_id=mission_id, revision=revision,

@@ -712,7 +712,7 @@ class PlannerNode(Node):
         else:
             msg = plan_msg(mission.problem, effect.posed, effect.result.schedule, effect.result,
                            mission.id, effect.revision, start, mission.settings.time_scale,
-                           stamp, effect.continued, effect.reasons, effect.incarnations)
+                           stamp, effect.restarted_in, effect.reasons, effect.incarnations)
         self.last_published = (msg.mission_id, msg.revision, msg.stamp)
         self.last_plan = msg
         if self.journal is not None:

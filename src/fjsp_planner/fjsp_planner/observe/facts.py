@@ -45,6 +45,13 @@ class PlannedTask:
     predecessors: tuple[str, ...]
     held_into_next: bool
     continued: bool
+    restarted_in: int
+    """The revision that last started the job afresh (0 if the plan does not say)."""
+
+    def attempt_since(self, revision: int) -> int:
+        """The revision whose attempt at the job this task, of plan `revision`, goes on with
+        (0: unknown)."""
+        return revision if not self.continued else min(self.restarted_in, revision)
 
 
 @dataclass(frozen=True)
@@ -201,7 +208,9 @@ class Decoder:
                         location=t.location, travel_start=t.travel_start, arrival=t.arrival,
                         start=t.start, operation_end=t.operation_end, end=t.end,
                         co_workers=tuple(t.co_workers), predecessors=tuple(t.predecessors),
-                        held_into_next=bool(t.held_into_next), continued=bool(t.continued))
+                        held_into_next=bool(t.held_into_next), continued=bool(t.continued),
+                        # A recording made before plans carried it decodes without it.
+                        restarted_in=int(getattr(t, 'restarted_in', 0)))
             for r in msg.robots for t in r.tasks)
         return PlanFact(stamp=seconds(msg.stamp), mission_id=msg.mission_id,
                         revision=msg.revision, scenario_id=msg.scenario_id,

@@ -15,9 +15,9 @@ mission event and every change of each robot's state, and derives from them:
 Everything is derived on demand from sets of facts, so the result does not depend on the
 order in which messages of different topics arrive: the live monitor and a replay of the
 recording of the same mission build the same history. Events are grouped into attempts by the
-revision that started their job afresh (`PlanTask.continued` false). A history that missed
-early plans (a monitor started late gets only the latched latest plan) falls back to the
-revisions its STARTED events carry.
+revision that started their job afresh (`PlanTask.continued` false, or `restarted_in` of a
+later plan that continues it). A history that missed early plans (a monitor started late
+gets only the latched latest plan) also takes the revisions its STARTED events carry.
 
 Times are schedule units since the mission start; stamps are wall seconds since the epoch.
 A robot is offline while no state of it is stamped within `heartbeat_timeout` seconds: gaps
@@ -296,12 +296,18 @@ class MissionHistory:
 
     def _attempts(self) -> list[Attempt]:
         restarts: dict[str, set[int]] = defaultdict(set)
+        spans: dict[str, set[tuple[int, int]]] = defaultdict(set)
+        """Per job, revisions known to run one attempt: from its restart to a plan continuing
+        it."""
         for plan in self.plans.values():
             for task in plan.tasks:
-                if not task.continued:
-                    restarts[task.job].add(plan.revision)
+                since = task.attempt_since(plan.revision)
+                restarts[task.job].add(since)
+                if since:
+                    spans[task.job].add((since, plan.revision))
         for event in self.task_events.values():
-            if event.kind == EventKind.STARTED and event.revision not in self.plans:
+            if event.kind == EventKind.STARTED and event.revision not in self.plans and not any(
+                    since <= event.revision <= until for since, until in spans[event.job]):
                 restarts[event.job].add(event.revision)
         groups: dict[str, dict[int, _Group]] = defaultdict(dict)
 

@@ -130,8 +130,8 @@ def _detail(mission: MissionHistory, state, mode: RobotMode) -> str:
 
 def _arrived(mission: MissionHistory, job: str, revision: int) -> set[str]:
     """Robots that reported arriving at `job` for the attempt `revision` works on."""
-    restarted = max((r for r, p in mission.plans.items() if r <= revision
-                     and any(t.job == job and not t.continued for t in p.tasks)), default=0)
+    restarted = max((t.attempt_since(r) for r, p in mission.plans.items() if r <= revision
+                     for t in p.tasks if t.job == job), default=0)
     return {e.robot for e in mission.task_events.values()
             if e.job == job and e.kind == EventKind.ARRIVED and e.revision >= restarted}
 
