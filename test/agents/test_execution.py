@@ -493,6 +493,27 @@ def test_a_later_mission_leaves_no_earlier_than_planned_although_placed():
     assert kinds(r.step(6.1)) == [(ARRIVED, 'J3', 6), (STARTED, 'J3', 6)]
 
 
+def test_a_robot_stands_where_the_plan_starts_it_until_its_own_legs_move_it():
+    """Found from outside: a robot with no task in a plan reported no location for the whole
+    mission, though the scenario starts it at the depot, so monitors showed it nowhere."""
+    idle, busy = RobotExecution('H1'), RobotExecution('N1')
+    idle.set_plan(1, (), {'J1': {'N1'}}, 0.0, restarted_in={}, start_location='depot')
+    assert idle.location == 'depot' and idle.mode == RobotMode.IDLE
+    busy.set_plan(1, [task('J1', 3, 1, leg=3, location='site')], {'J1': {'N1'}}, 0.0,
+                  restarted_in={'J1': 1}, start_location='depot')
+    busy.step(1)
+    assert (busy.location, busy.destination) == ('depot', 'site')
+    busy.step(5)
+    assert busy.location == 'site'
+    # A later revision placing it elsewhere does not move a robot its own legs placed.
+    busy.set_plan(2, (), {}, 5.0, restarted_in={}, start_location='depot')
+    assert busy.location == 'site'
+    # A robot that may start anywhere stays unplaced until its first job.
+    anywhere = RobotExecution('N2')
+    anywhere.set_plan(1, (), {}, 0.0, restarted_in={}, start_location='')
+    assert anywhere.location == ''
+
+
 def test_failing_while_waiting_at_a_job_withdraws_from_it():
     """Found by the soak: T2 arrived at PetalA, failed there before the job began and
     recovered at once, its tasks dropped. T1 knew only of its arrival, started PetalA alone,

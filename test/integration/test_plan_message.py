@@ -26,3 +26,24 @@ def test_a_revision_names_the_predecessors_done_before_it():
     assert {t.job for t in tasks} == {j.name for j in posed.jobs}
     assert all(sorted(t.predecessors) == ['M1', 'M2'] for t in tasks if t.job in ('Ja', 'Jb'))
     assert all(list(t.predecessors) == ['Ja'] for t in tasks if t.job == 'Aa')
+
+
+def test_every_robot_is_placed_where_the_plan_starts_it():
+    """A robot the plan gives no task still learns where it stands (the scenario's start, or
+    where a re-plan has it); one the scenario may start anywhere, or one left out, gets no
+    place."""
+    scenario = load_scenario(SCENARIO)
+    placed = dataclasses.replace(scenario, robots=tuple(
+        dataclasses.replace(r, start_location='Jd') if r.name == 'MARC2' else r
+        for r in scenario.robots))
+    result = solve(placed, time_limit=2, workers=1)
+    msg = plan_msg(placed, placed, result.schedule, result, 'mission', 1, 0.0, 1.0, None)
+    assert {r.robot: r.start_location for r in msg.robots} == {
+        'Assembler': '', 'LSMS': '', 'MARC1': '', 'MARC2': 'Jd'}
+    without_marc2 = dataclasses.replace(placed, robots=tuple(
+        dataclasses.replace(r, start_location='Aa') for r in placed.robots
+        if r.name != 'MARC2'))
+    result = solve(without_marc2, time_limit=2, workers=1)
+    msg = plan_msg(placed, without_marc2, result.schedule, result, 'mission', 2, 0.0, 1.0, None)
+    assert {r.robot: r.start_location for r in msg.robots} == {
+        'Assembler': 'Aa', 'LSMS': 'Aa', 'MARC1': 'Aa', 'MARC2': ''}

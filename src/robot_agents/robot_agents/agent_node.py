@@ -194,7 +194,7 @@ class RobotAgent(Node):
             # What was due before the new revision happened under the old one.
             self.publish_events(self.execution.step(now))
         self.execution.set_plan(msg.revision, tasks, job_robots, max(now, 0.0),
-                                restarted_in=restarted_in)
+                                restarted_in=restarted_in, start_location=mine.start_location)
         log.info(f"following plan revision {msg.revision} of mission '{mission}': "
                  + (' -> '.join(t.job for t in tasks) or 'no task'))
         self.publish_state()  # a new revision is a transition, even before the mission start

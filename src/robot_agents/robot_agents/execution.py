@@ -194,8 +194,13 @@ class RobotExecution:
 
     # --- plans -----------------------------------------------------------------------
 
-    def set_plan(self, revision: int, tasks, job_robots, now: float, *, restarted_in) -> None:
+    def set_plan(self, revision: int, tasks, job_robots, now: float, *, restarted_in,
+                 start_location: str = '') -> None:
         """Follow a newer revision from `now`.
+
+        `start_location` is where the plan has the robot before its first task ('' if it may
+        start anywhere): a robot no leg has placed yet is there, one placed stays where its
+        own legs took it.
 
         `job_robots` maps every job of the plan to its robots; `restarted_in` maps a job to
         the revision that last started it afresh: an older one for a job that goes on as it
@@ -213,6 +218,8 @@ class RobotExecution:
             raise ValueError(f'plan revision {revision} is not newer than revision '
                              f'{self.revision} already followed')
         tasks = tuple(tasks)
+        if not self.location and self._phase not in (_Phase.TRAVEL, _Phase.TRANSIT):
+            self.location = start_location
         current = self.task
         previous, self.revision = self.revision, revision
         self._job_robots = {job: frozenset(robots) for job, robots in job_robots.items()}

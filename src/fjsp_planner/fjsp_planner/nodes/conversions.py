@@ -17,13 +17,14 @@ def plan_msg(scenario: Problem, posed: Problem, schedule: Schedule, result: Resu
              restarted_in=None, reasons=(), incarnations=None) -> Plan:
     """The plan message of a schedule of `posed`: every robot's tasks with travel, times and
     partners. `posed` is the scenario itself, or what remained of it at a re-plan; every
-    robot of the scenario is listed, the ones left out of `posed` with no task, each with
+    robot of the scenario is listed, with where `posed` starts it, the ones left out of
+    `posed` with no task and no place, each with
     the agent incarnation its tasks are for (`incarnations`; 0 where not given).
     `restarted_in` maps a job to the revision that last started it afresh, `revision` (a
     job not continued) where not given."""
     restarted_in = restarted_in or {}
     holds = {(a, q): b for a, b, q in posed.holding}
-    in_posed = {r.name for r in posed.robots}
+    in_posed = {r.name: r for r in posed.robots}
     robots = []
     for robot in scenario.robots:
         sequence = schedule.sequences.get(robot.name, ()) if robot.name in in_posed else ()
@@ -47,7 +48,9 @@ def plan_msg(scenario: Problem, posed: Problem, schedule: Schedule, result: Resu
                 and holds.get((visit.job, q)) == following,
                 continued=restarted_in.get(visit.job, revision) < revision,
                 restarted_in=min(restarted_in.get(visit.job, revision), revision)))
-        robots.append(RobotPlan(robot=robot.name, robot_type=robot.type, tasks=tasks,
+        start = in_posed[robot.name].start_location if robot.name in in_posed else None
+        robots.append(RobotPlan(robot=robot.name, robot_type=robot.type,
+                                start_location=start or '', tasks=tasks,
                                 incarnation=(incarnations or {}).get(robot.name, 0)))
     return Plan(stamp=stamp, mission_id=mission_id, revision=revision,
                 scenario_id=scenario.name, reasons=list(reasons),
