@@ -132,6 +132,42 @@ def test_cancel_leaves_the_fleet_idle_for_the_next_mission(client, observer):
     check_done_once(load_scenario(SCENARIO), observer, third.mission_id)
 
 
+class _SlowToRegister:
+    """An action client's handle that pauses after sending each request: the time an answer
+    has to come back before rclpy's action client files the request it answers."""
+
+    def __init__(self, handle):
+        self._handle = handle
+
+    def __getattr__(self, name):
+        found = getattr(self._handle, name)
+        if not name.startswith('send_'):
+            return found
+
+        def send(*args):
+            sequence_number = found(*args)
+            time.sleep(0.5)
+            return sequence_number
+        return send
+
+    def __enter__(self):
+        return self._handle.__enter__()
+
+    def __exit__(self, *exc):
+        return self._handle.__exit__(*exc)
+
+
+def test_an_answer_back_before_its_request_is_filed_still_counts(client, observer):
+    """Found by CI: a cancel was answered, but the answer was dropped ("Ignoring unexpected
+    cancel response") and `cancel()` gave up after 10 s. rclpy's action client files a
+    request only after sending it (ros2/rclpy#1123); an answer the client's executor thread
+    takes in between is lost, for a goal, a cancel or a result alike."""
+    client._action._client_handle = _SlowToRegister(client._action._client_handle)
+    mission = client.submit(SCENARIO, timeout=5)
+    mission.cancel(timeout=5)
+    assert mission.result(timeout=10).state == 'cancelled'
+
+
 SECOND_PANEL = SCENARIO.parents[1] / 'fragments' / 'solar_panel_second_panel.yaml'
 
 

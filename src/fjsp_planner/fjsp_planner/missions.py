@@ -31,6 +31,8 @@ from pathlib import Path
 
 RESEND = 1.0
 """Seconds without an answer after which a request is sent again."""
+SEND_TIMEOUT = 10.0
+"""Seconds a request may wait for the client's executor thread to send it."""
 RESULT_STATES = ('complete', 'cancelled', 'failed', 'blocked too long', 'rejected')
 """RunMission.Result.STATE_* in order."""
 
@@ -67,7 +69,7 @@ class MissionHandle:
         self._client = client
         self._goal = goal_handle
         self.mission_id = mission_id
-        self._result = goal_handle.get_result_async()
+        self._result = client._sent(goal_handle.get_result_async)
 
     def result(self, timeout: float | None = None) -> MissionResult:
         """Wait for the mission to end; MissionError after `timeout` seconds."""
@@ -80,7 +82,7 @@ class MissionHandle:
             # An action's cancel cannot be signed; the signed service does the same.
             self._client.cancel(self.mission_id, timeout=timeout)
             return
-        future = self._goal.cancel_goal_async()
+        future = self._client._sent(self._goal.cancel_goal_async)
         if not self._client._wait(future, timeout):
             raise MissionError('the planner did not answer the cancel request within '
                                f'{timeout:g} s')
@@ -148,6 +150,17 @@ class MissionClient:
         self._status = msg
         self._status_seen.set()
 
+    def _sent(self, send):
+        """What `send()` returns, called on the executor thread. rclpy's action client files
+        a request only after sending it (ros2/rclpy#1123): an answer the executor thread took
+        in between would be dropped and its request never answered. Sent from that thread, the
+        answer is taken once the request is filed."""
+        task = self._executor.create_task(send)
+        if not self._wait(task, SEND_TIMEOUT):
+            raise MissionError(f'the client could not send a request within {SEND_TIMEOUT:g} '
+                               's: is it closed, or called from one of its own callbacks?')
+        return task.result()
+
     def _wait(self, future, timeout) -> bool:
         done = threading.Event()
         future.add_done_callback(lambda _: done.set())
@@ -213,7 +226,8 @@ class MissionClient:
         deadline = time.monotonic() + timeout
         while True:
             self._signer.sign(goal, self._node.resolve_topic_name(self._action_name))
-            accepted = self._action.send_goal_async(goal, feedback_callback=on_feedback)
+            accepted = self._sent(lambda: self._action.send_goal_async(
+                goal, feedback_callback=on_feedback))
             if self._wait(accepted, min(RESEND, max(deadline - time.monotonic(), 0.0))):
                 break
             if time.monotonic() >= deadline:
