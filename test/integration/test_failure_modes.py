@@ -89,7 +89,11 @@ def test_no_robot_is_declared_offline_in_a_quiet_mission(fjsp_fleet):
     time.sleep(2.0)
     assert 'offline' not in fleet.log('planner')
     assert observer.status.state == MissionStatus.STATE_COMPLETE
-    assert observer.status.plan_revision == 1
+    # The one re-plan a quiet mission may see is around a robot that never got the plan: in
+    # a CI run the planner heard MARC1 throughout, but MARC1 received no revision, resent on
+    # new writers too, and was rightly planned without after `plan_uptake_timeout`.
+    reasons = [reason for plan in observer.plans for reason in plan.reasons]
+    assert all('has not taken plan revision' in reason for reason in reasons), reasons
     done = [e for e in observer.events if e.kind == TaskEvent.KIND_JOB_DONE]
     assert len(done) == 12
 
