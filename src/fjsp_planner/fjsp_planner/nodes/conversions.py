@@ -17,9 +17,9 @@ def plan_msg(scenario: Problem, posed: Problem, schedule: Schedule, result: Resu
              restarted_in=None, reasons=(), incarnations=None) -> Plan:
     """The plan message of a schedule of `posed`: every robot's tasks with travel, times and
     partners. `posed` is the scenario itself, or what remained of it at a re-plan; every
-    robot of the scenario is listed, with where `posed` starts it, the ones left out of
-    `posed` with no task and no place, each with
-    the agent incarnation its tasks are for (`incarnations`; 0 where not given).
+    robot of the scenario is listed with where `posed` starts it (the ones left out of
+    `posed` with no task and no place) and the agent incarnation its tasks are for
+    (`incarnations`; 0 where not given).
     `restarted_in` maps a job to the revision that last started it afresh, `revision` (a
     job not continued) where not given."""
     restarted_in = restarted_in or {}
