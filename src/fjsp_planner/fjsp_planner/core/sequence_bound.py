@@ -111,10 +111,43 @@ def panel_sequence_bound(problem: Problem, incumbent: Fraction, time_limit: floa
     open or let go, once `stop` is set; `improved` gives the makespan of a shorter schedule found
     meanwhile, if any (orders that cannot end before it are then dropped too, and the
     bound holds below it)."""
+    deadline = time.monotonic() + time_limit
+    prepared = _prepared_search(problem, incumbent)
+    if prepared is None:
+        return None
+    search, helped_count = prepared
+    layouts = [search.shapes(helped) for helped in search.layouts(helped_count)]
+    found = min(search.run(layouts, deadline, stop, improved), incumbent)
+    shorter = improved() if improved is not None else None
+    return found if shorter is None else min(found, shorter)
+
+
+def layouts(problem: Problem, incumbent: Fraction) -> list[tuple[int, ...]]:
+    """The layouts `panel_sequence_bound` searches, each as the panels (numbered from 0)
+    where limited robots work; empty when the bound does not apply."""
+    prepared = _prepared_search(problem, incumbent)
+    return [] if prepared is None else prepared[0].layouts(prepared[1])
+
+
+def layout_value(problem: Problem, incumbent: Fraction, helped: tuple[int, ...],
+                 time_limit: float, max_open: int | None = None) -> Fraction:
+    """The relaxation's least makespan in the one layout where limited robots work in the
+    panels `helped` (one of `layouts`), or the least value still open or let go (above
+    `max_open` open orders, default `MAX_OPEN`) when `time_limit` ran out. Searched to their
+    ends, the least over the layouts is what `panel_sequence_bound` reaches at its end: this
+    tells which layout holds the bound down and how far each is from the incumbent
+    (`bench/panel_layouts.py`)."""
+    search, _ = _prepared_search(problem, incumbent)
+    return min(search.run([search.shapes(helped)], time.monotonic() + time_limit,
+                          max_open=max_open), incumbent)
+
+
+def _prepared_search(problem, incumbent):
+    """(the search, how many panels limited robots may work in), or None when the bound does
+    not apply (see `panel_sequence_bound`)."""
     panels = len(problem.panels)
     if not 2 <= panels <= MAX_PANELS or problem.fixed:
         return None
-    deadline = time.monotonic() + time_limit
     limits = panel_limits(problem, incumbent)
     group = frozenset(r.name for r in problem.robots if r.name not in limits)
     if not group:
@@ -126,11 +159,7 @@ def panel_sequence_bound(problem: Problem, incumbent: Fraction, time_limit: floa
     if bare is None or helped is None or not (bare[0] or helped[0]) or max(
             len(bare[0]), len(helped[0])) > MAX_PANEL_JOBS:
         return None
-    search = _Search(problem, bare, helped, sorted(limits), incumbent)
-    layouts = search.layouts(helped_count)
-    found = min(search.run(layouts, deadline, stop, improved), incumbent)
-    shorter = improved() if improved is not None else None
-    return found if shorter is None else min(found, shorter)
+    return _Search(problem, bare, helped, sorted(limits), incumbent), helped_count
 
 
 def _kept_jobs(problem, allowed, group, limited, incumbent):
@@ -228,8 +257,9 @@ class _Search:
                          if not done >> j & 1), default=None) for done in range(shape.full + 1)]
 
     def layouts(self, helped_count):
-        """Every set of at most `helped_count` panels, one of each pair of mirror images
-        when the travel between panels reads the same from the other end."""
+        """Every set of at most `helped_count` panels (as sorted panel numbers), one of each
+        pair of mirror images when the travel between panels reads the same from the other
+        end."""
         last = self.panels - 1
         mirrored = all(value == self.travel[r, last - k, a, last - m, b]
                        for (r, k, a, m, b), value in self.travel.items())
@@ -239,8 +269,12 @@ class _Search:
                 mirror = tuple(sorted(last - k for k in helped))
                 if not (mirrored and mirror in chosen):
                     chosen.append(helped)
-        return [tuple(self.helped if k in helped else self.bare for k in range(self.panels))
-                for helped in chosen]
+        return chosen
+
+    def shapes(self, helped):
+        """The layout in which limited robots work in the panels `helped`: each panel's
+        shape."""
+        return tuple(self.helped if k in helped else self.bare for k in range(self.panels))
 
     def gap(self, k, first, a, m, second, b):
         """Least time from job a's end (panel k, `first` choice) to job b's start (panel m,
@@ -296,11 +330,12 @@ class _Search:
             where[n] == (p, i) for n, robot in enumerate(self.limited)
             if robot in choice.limited)
 
-    def run(self, layouts, deadline, stop=None, improved=None) -> Fraction:
+    def run(self, layouts, deadline, stop=None, improved=None, max_open=None) -> Fraction:
         """The least makespan of the relaxation over `layouts` (per panel, its shape), or the
         least value still open or let go when the deadline comes or the search reaches the
         orders let go (a lower bound either way); the incumbent when no order ends before
-        it."""
+        it. Above `max_open` open orders (default `MAX_OPEN`) some are let go."""
+        max_open = MAX_OPEN if max_open is None else max_open
         self.layout_shapes = layouts
         self.helped_masks = [sum(1 << k for k, shape in enumerate(shapes) if shape is self.helped)
                              for shapes in layouts]
@@ -331,12 +366,12 @@ class _Search:
             if expansions % 512 == 0:
                 if time.monotonic() > deadline or (stop is not None and stop.is_set()):
                     return Fraction(min(self.frontier[0][0], let_go), self.scale)
-                if len(self.frontier) > MAX_OPEN:
+                if len(self.frontier) > max_open:
                     # The orders of highest value are let go: none of what follows them ends
                     # before the least of them, which caps the bound, and the memory they
                     # held lets the search go on raising the bound up to it.
                     self.frontier.sort()
-                    kept = MAX_OPEN * 3 // 4
+                    kept = max_open * 3 // 4
                     let_go = min(let_go, self.frontier[kept][0])
                     del self.frontier[kept:]
                 shorter = improved() if improved is not None else None
