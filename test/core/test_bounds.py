@@ -180,6 +180,8 @@ def test_sequence_bound_on_the_paper_three_panels_is_the_least_of_its_layouts():
     assert values[()] == known
     assert min(values.values()) == values[(1,)] == Fraction(439, 3)
     assert Fraction(439, 3) < values[(0,)] < known
+    with pytest.raises(ValueError, match=r'panels \(0, 1\) are not a layout'):
+        sequence_bound.layout_value(problem, known, (0, 1), 30)  # the Assembler cannot cross
 
 
 @pytest.mark.parametrize(('open_orders', 'known'), [

@@ -136,8 +136,13 @@ def layout_value(problem: Problem, incumbent: Fraction, helped: tuple[int, ...],
     `max_open` open orders, default `MAX_OPEN`) when `time_limit` ran out. Searched to their
     ends, the least over the layouts is what `panel_sequence_bound` reaches at its end: this
     tells which layout holds the bound down and how far each is from the incumbent
-    (`bench/panel_layouts.py`)."""
-    search, _ = _prepared_search(problem, incumbent)
+    (`bench/panel_layouts.py`). ValueError when the bound does not apply or `helped` is
+    not one of the layouts."""
+    prepared = _prepared_search(problem, incumbent)
+    if prepared is None or tuple(helped) not in prepared[0].layouts(prepared[1]):
+        raise ValueError(f'panels {tuple(helped)} are not a layout of the panel sequence bound '
+                         'on this problem')
+    search, _ = prepared
     return min(search.run([search.shapes(helped)], time.monotonic() + time_limit,
                           max_open=max_open), incumbent)
 
