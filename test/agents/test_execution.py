@@ -94,23 +94,48 @@ def test_a_robot_goes_on_from_its_own_job_without_the_planner():
     assert kinds(r.step(3.5)) == [(ARRIVED, 'J2', 2), (STARTED, 'J2', 2), (DONE, 'J2', 3)]
 
 
-def holder():
-    """A holds jig job Ja (with B) into Aa: Ja's operations end at 1 (A) and 5 (B)."""
+def holder(leg=2.0):
+    """A holds jig job Ja (with B) into Aa, `leg` units away: Ja's operations end at 1 (A)
+    and 5 (B), and Aa is planned to start once the part is carried there."""
     r = RobotExecution('A')
     plan(r, 1, [task('Ja', 0, 1, end=5, co=['B'], held=True),
-                task('Aa', 5, 5, co=['B'], preds=['Ja'], leg=2)],
+                task('Aa', 5 + leg, 5, co=['B'], preds=['Ja'], leg=leg,
+                     location='Aa' if leg else 'Ja')],
          {'Ja': {'A', 'B'}, 'Aa': {'A', 'B'}})
     r.arrived('B', 'Ja', 0.0, 1)
     return r
 
 
-def test_holder_stays_holding_into_the_next_job():
-    r = holder()
+def test_holder_carries_the_part_along_its_leg_into_the_next_job():
+    r = holder(leg=2.0)
     r.step(2)
     assert r.mode == RobotMode.HOLDING and r.current_job == 'Ja'
     r.operation_done('B', 'Ja', 5.0, 1)
-    assert kinds(r.step(5)) == [(ARRIVED, 'Aa', 5)]   # no travel while holding
+    assert r.step(6) == []                               # on its way, part in hand
+    assert r.mode == RobotMode.TRAVELLING and r.destination == 'Aa'
+    assert r.busy_until == pytest.approx(7)
+    assert kinds(r.step(7.1)) == [(ARRIVED, 'Aa', 7)]    # the leg took its travel time
+    assert r.mode == RobotMode.HOLDING and r.current_job == 'Aa' and r.location == 'Aa'
+
+
+def test_holder_whose_next_job_is_at_the_same_place_goes_straight_on():
+    r = holder(leg=0.0)
+    r.step(2)
+    r.operation_done('B', 'Ja', 5.0, 1)
+    assert kinds(r.step(5)) == [(ARRIVED, 'Aa', 5)]
     assert r.mode == RobotMode.HOLDING and r.current_job == 'Aa'
+
+
+def test_a_robot_already_at_its_next_jobs_place_does_not_travel_there_again():
+    # Revision 1 sends A from J1 to J2 (3 units); revision 2, at 2, drops J2 and plans J3
+    # at J2's place with the leg from J1 it would take had A not set off. A ends its leg at
+    # 4, where J3 is: it has no way left to go.
+    r = RobotExecution('A')
+    plan(r, 1, [task('J1', 0, 1), task('J2', 4, 1, leg=3)])
+    r.step(2)
+    assert r.mode == RobotMode.TRAVELLING
+    plan(r, 2, [task('J3', 5, 1, leg=3, location='J2')], now=2)
+    assert kinds(r.step(4.5)) == [(ARRIVED, 'J3', 4), (STARTED, 'J3', 4)]
 
 
 def test_stale_revision_is_refused():
@@ -191,15 +216,15 @@ def test_fail_mid_leg_freezes_it_and_recovery_ends_the_leg():
 def test_fail_while_holding_releases_the_hold():
     r = holder()
     r.operation_done('B', 'Ja', 5.0, 1)
-    r.step(6)
+    r.step(7.5)
     assert r.mode == RobotMode.HOLDING and r.current_job == 'Aa'
-    result = r.fail(6)
+    result = r.fail(7.5)
     # It withdraws from Aa, where it held Ja's part waiting for B: B must not start Aa
     # with it.
-    assert result.accepted and kinds(result.events) == [(ABORTED, 'Aa', 6)]
+    assert result.accepted and kinds(result.events) == [(ABORTED, 'Aa', 7.5)]
     assert r.mode == RobotMode.FAILED
     # The planner voids Ja (its holder failed) and gives A nothing while it is down.
-    plan(r, 2, [], {'Ja': {'B'}, 'Aa': {'B'}}, now=6.5)
+    plan(r, 2, [], {'Ja': {'B'}, 'Aa': {'B'}}, now=7.75)
     r.recover(8)
     assert r.mode == RobotMode.IDLE and r.location == 'Aa'
     # Ja is redone under revision 3: no longer held, so A travels there.
@@ -437,13 +462,14 @@ def test_own_operation_done_and_continued_keeps_waiting_for_the_job_end():
 def test_holder_keeps_holding_through_a_restart_of_the_held_job():
     r = holder()
     r.operation_done('B', 'Ja', 5.0, 1)
-    r.step(6)                              # holding Ja's part, waiting at Aa for B
-    # Revision 2 keeps the done jig job Ja for its holder and restarts Aa.
+    r.step(6)                              # carrying Ja's part to Aa, arriving at 7
+    # Revision 2 keeps the done jig job Ja for its holder and restarts Aa with C.
     plan(r, 2, [task('Ja', 0, 1, end=5, held=True),
-                task('Aa', 8, 5, co=['C'], preds=['Ja'], leg=2)],
-         {'Ja': {'A'}, 'Aa': {'A', 'C'}}, now=7, continued={'Ja'})
-    assert attempts(r.step(7)) == [(ARRIVED, 'Aa', 2)]   # no travel: still holding
-    assert r.mode == RobotMode.HOLDING
+                task('Aa', 8, 5, co=['C'], preds=['Ja'], leg=2, location='Aa')],
+         {'Ja': {'A'}, 'Aa': {'A', 'C'}}, now=6, continued={'Ja'})
+    # It ends the leg it is on, which took it to Aa's place: nothing left to travel.
+    assert attempts(r.step(7.5)) == [(ARRIVED, 'Aa', 2)]
+    assert r.mode == RobotMode.HOLDING and r.location == 'Aa'
     r.arrived('C', 'Aa', 8.0, 2)
     assert kinds(r.step(8)) == [(STARTED, 'Aa', 8)]
 
@@ -451,13 +477,14 @@ def test_holder_keeps_holding_through_a_restart_of_the_held_job():
 def test_running_held_job_after_a_done_jig_job_is_continued():
     r = holder()
     r.operation_done('B', 'Ja', 5.0, 1)
-    r.arrived('B', 'Aa', 5.0, 1)
-    r.step(6)
+    r.arrived('B', 'Aa', 7.0, 1)
+    r.step(8)
     assert r.mode == RobotMode.WORKING and r.current_job == 'Aa'
-    plan(r, 2, [task('Ja', 0, 1, end=5, held=True), task('Aa', 5, 5, co=['B'], preds=['Ja'])],
-         {'Ja': {'A'}, 'Aa': {'A', 'B'}}, now=6, continued={'Ja', 'Aa'})
+    plan(r, 2, [task('Ja', 0, 1, end=5, held=True),
+                task('Aa', 7, 5, co=['B'], preds=['Ja'], leg=2, location='Aa')],
+         {'Ja': {'A'}, 'Aa': {'A', 'B'}}, now=8, continued={'Ja', 'Aa'})
     assert r.mode == RobotMode.WORKING and r.current_job == 'Aa'
-    assert kinds(r.step(10.1)) == [(DONE, 'Aa', 10)]
+    assert kinds(r.step(12.1)) == [(DONE, 'Aa', 12)]
 
 
 def test_first_leg_leaves_from_the_start_location_once_released():

@@ -19,6 +19,7 @@ SCENARIOS = Path(__file__).resolve().parents[2] / 'config' / 'scenarios'
 @pytest.mark.parametrize(('scenario', 'optimum'), [
     ('truss.yaml', Fraction(23)),
     ('antenna.yaml', Fraction(88, 5)),
+    ('habitat.yaml', Fraction(58)),
 ])
 def test_shipped_scenario_is_proven_optimal(scenario, optimum):
     problem = load_scenario(SCENARIOS / scenario)
@@ -29,3 +30,10 @@ def test_shipped_scenario_is_proven_optimal(scenario, optimum):
     assert result.status == Status.OPTIMAL, result
     assert result.makespan == optimum
     assert validate(problem, result.schedule) == []
+
+
+def test_a_shipped_scenario_carries_a_held_part_between_two_places():
+    problem = load_scenario(SCENARIOS / 'habitat.yaml')
+    assert any(problem.job(a).location != problem.job(b).location
+               for a, b, _ in problem.holding)
+    assert problem.operation_types[problem.locomote] != 'locomote'

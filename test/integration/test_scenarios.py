@@ -1,6 +1,7 @@
 """Fleets that are not the paper's run to completion on the node network: the scenarios'
 own robot types played by the generic agent, robots leaving from their start locations no
-earlier than their release times, alternative plans, precedence and holding arcs."""
+earlier than their release times, alternative plans, precedence and holding arcs, within one
+place and across two (holders carry the part along their leg)."""
 
 from pathlib import Path
 
@@ -12,7 +13,7 @@ SCENARIOS = Path(__file__).resolve().parents[2] / 'config' / 'scenarios'
 PAPER_TYPES = {'Assembler', 'MARC', 'LSMS'}
 
 
-@pytest.mark.parametrize('scenario', ['truss.yaml', 'antenna.yaml'])
+@pytest.mark.parametrize('scenario', ['truss.yaml', 'antenna.yaml', 'habitat.yaml'])
 def test_scenario_runs_to_completion(fjsp_fleet, scenario):
     fleet = fjsp_fleet(SCENARIOS / scenario, time_scale=0.05, planner={'time_limit': 10.0})
     problem = fleet.problem

@@ -495,7 +495,9 @@ class RobotExecution:
         # location; a robot that may start anywhere has no first leg). Placed or not, its
         # first leg of a mission leaves no earlier than the plan has it leave: its release
         # time (or the job's start for a robot not placed), which only the plan knows.
-        leg = 0.0 if self._holding else max(task.leg, 0.0)
+        # A holder carries the held part along its leg. A robot already at the job's place
+        # (a leg it ended under an older revision took it there) has no way left to go.
+        leg = 0.0 if self.location == task.location else max(task.leg, 0.0)
         if not self._departed:
             departure = max(departure, task.travel_start)
             self._departed = True
