@@ -341,6 +341,45 @@ def test_deadlocked_holds_are_given_up():
     assert result.result.makespan == 13
 
 
+def carried():
+    """A and B lift a part at p (2 units) and carry it, still holding, 4 units to q, to
+    place it there (2 units) once D has scanned the spot (7 units); C, a spare drone at q,
+    has nothing to do. Planned: Lift [0, 2], the leg [2, 6], holding at q until Scan ends,
+    Place [7, 9]."""
+    problem = Problem(
+        operation_types={0: 'lift', 1: 'scan', 2: 'drive'},
+        robot_types={'Rover': {0: Fraction(2), 2: Fraction(1)},
+                     'Drone': {1: Fraction(7), 2: Fraction(1)}},
+        robots=(Robot('A', 'Rover', start_location='p'), Robot('B', 'Rover', start_location='p'),
+                Robot('C', 'Drone', start_location='q'), Robot('D', 'Drone', start_location='q')),
+        jobs=(Job('Lift', 'p', ((0, 0),)), Job('Place', 'q', ((0, 0),)),
+              Job('Scan', 'q', ((1,),))),
+        distances={('p', 'q'): Fraction(4), ('q', 'p'): Fraction(4)},
+        precedence=(('Lift', 'Place'), ('Scan', 'Place')),
+        holding=(('Lift', 'Place', 0),),
+        locomote=2,
+        name='carried',
+    )
+    plan = Schedule(
+        jobs={'Lift': JobAssignment('Lift', 0, Fraction(0), Fraction(2), {'A': 0, 'B': 0}),
+              'Place': JobAssignment('Place', 0, Fraction(7), Fraction(9), {'A': 0, 'B': 0}),
+              'Scan': assign('Scan', 0, 7, {'D': 1})},
+        sequences={'A': ('Lift', 'Place'), 'B': ('Lift', 'Place'), 'C': (), 'D': ('Scan',)})
+    assert validate(problem, plan) == []
+    return problem, plan
+
+
+@pytest.mark.parametrize('now', [1, 4, Fraction(13, 2)],
+                         ids=['lifting', 'carrying', 'holding at q'])
+def test_holders_carrying_a_part_are_replanned_from_where_they_are(now):
+    """C fails at `now`, which nothing needs: the re-plan has the holders go on from where
+    they are, so Place still starts at 7 once Scan is done, not a whole leg after `now`."""
+    problem, plan = carried()
+    result = check_replan(problem, plan, at(problem, now, {'C'}, plan), time_limit=5.0)
+    assert result.schedule.jobs['Place'].start == 7
+    assert result.result.makespan == 9
+
+
 @pytest.fixture(scope='module')
 def paper():
     problem = load_scenario(SCENARIO)

@@ -332,11 +332,12 @@ def residual_problem(problem: Problem, state: ExecutionState,
               if not set(h.holders) <= healthy or h.source in release or _lost(h, state)}
     aborted.update(h.target for h in holds if h.source in voided and h.target in state.running)
     fixed = {name: a for name, a in state.running.items() if name not in aborted}
-    kept, began = {}, {}
+    kept, began, carried_to = {}, {}, {}
     for h in holds:
         if h.source not in voided and h.target not in fixed:
             kept.setdefault(h.source, {}).update(h.holders)
             began[h.source] = h.began
+            carried_to.update(dict.fromkeys(h.holders, h.target))
     _raise_on_hold_conflicts(holds, kept, state.running)
 
     order = [j.name for j in problem.jobs]
@@ -352,7 +353,7 @@ def residual_problem(problem: Problem, state: ExecutionState,
     blocked = _staffing_problems(problem, todo, healthy, kept, residual.failed)
     if blocked:
         return replace(residual, blocked=blocked)
-    posed = _pose(problem, state, healthy, todo, fixed, kept, began, aborted)
+    posed = _pose(problem, state, healthy, todo, fixed, kept, began, carried_to, aborted)
     return replace(residual, problem=posed)
 
 
@@ -474,7 +475,7 @@ def _named(robots: Mapping[str, int]) -> str:
     return ', '.join(f"'{r}'" for r in sorted(robots))
 
 
-def _pose(problem, state, healthy, todo, fixed, kept, began, aborted) -> Problem:
+def _pose(problem, state, healthy, todo, fixed, kept, began, carried_to, aborted) -> Problem:
     """The residual `Problem`: todo + fixed running + kept jig jobs, healthy robots only."""
     now = state.now
     place = {}
@@ -507,11 +508,9 @@ def _pose(problem, state, healthy, todo, fixed, kept, began, aborted) -> Problem
         # keeps the fixed job consistent, and lets its other robots go on freely.
         job = problem.job(name)
         jobs.append(Job(job.name, job.location, (tuple(sorted(holders.values())),)))
-        # The holders have been busy holding since the jig job ended, so it ends at `now`
-        # for them: the held job then cannot start in the past (the solvers apply release
-        # times only to a robot's first job, and this fixed job comes first).
-        start = min(began[name], now - _longest(problem, holders))
-        pinned[name] = FixedJob(0, start, now, dict(holders))
+        end = _hold_end(problem, state, name, holders, carried_to)
+        start = min(began[name], end - _longest(problem, holders))
+        pinned[name] = FixedJob(0, start, end, dict(holders))
     names = {j.name for j in jobs}
     scheduled = {j.name for j in todo}
     precedence = tuple((a, b) for a, b in problem.precedence if a in names and b in scheduled)
@@ -532,6 +531,25 @@ def _pose(problem, state, healthy, todo, fixed, kept, began, aborted) -> Problem
         fixed=pinned,
         name=f'{problem.name}@{now}',
     )
+
+
+def _hold_end(problem, state, source, holders, carried_to) -> Fraction:
+    """When the kept jig job `source` ends for its holders, as its fixed job: the latest of
+    their departures to the jobs they hold into, so that none of them gets there earlier
+    than it can, nor in the past (the solvers apply release times only to a robot's first
+    job, and this fixed job comes first). A holder still at the jig job's place sets off at
+    `now`; one the state places at the held job's place, carrying the part there or holding
+    it there already, arrives when its state says."""
+    here = problem.job(source).location
+    departures = []
+    for robot in holders:
+        there = problem.job(carried_to[robot]).location
+        travel = problem.travel(robot, here, there)
+        s = state.robots[robot]
+        on_its_way = there != here and s.location == there
+        departures.append((max(state.now, s.free_at) if on_its_way else state.now + travel)
+                          - travel)
+    return max(departures)
 
 
 def _raise_on_state_problems(problem: Problem, state: ExecutionState) -> None:
