@@ -19,8 +19,8 @@ from pathlib import Path
 
 import yaml
 
-from fjsp_planner.core.scenario import load_scenario
 from fjsp_planner.missions import MissionClient
+from fjsp_planner.model.scenario import load_scenario
 from fjsp_planner.testing import FleetHarness
 
 REPO = Path(__file__).resolve().parents[1]

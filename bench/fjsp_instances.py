@@ -26,10 +26,10 @@ sys.path.insert(0, str(REPO / 'bench'))
 
 from pyjobshop_peer import run_peer  # noqa: E402
 
-from fjsp_planner.core.fjs import load_fjs  # noqa: E402
-from fjsp_planner.core.problem import ProblemError  # noqa: E402
-from fjsp_planner.core.solve import solve  # noqa: E402
-from fjsp_planner.core.validate import validate  # noqa: E402
+from fjsp_planner.model.fjs import load_fjs  # noqa: E402
+from fjsp_planner.model.problem import ProblemError  # noqa: E402
+from fjsp_planner.model.validate import validate  # noqa: E402
+from fjsp_planner.solving.solve import solve  # noqa: E402
 
 SOLVERS = ('cpsat', 'mip-scip', 'mip-highs')
 COLUMNS = ('instance', 'jobs', 'ops', 'machines', 'makespan', 'bound', 'gap', 'status',

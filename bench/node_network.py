@@ -1,9 +1,9 @@
 """Benchmark of the node network on the paper's one-panel mission (prints, never asserts).
 
 For each time scale: planner + four agents started by the fleet launcher
-(`fjsp_planner.fleet.Fleet`) in a private domain; plan publish -> every agent follows it
-(latency, from message stamps); per-node CPU and resident memory during the mission and at
-idle afterwards (from /proc); executed vs planned makespan in schedule units and the
+(`fjsp_planner.launcher.supervision.Fleet`) in a private domain; plan publish -> every agent
+follows it (latency, from message stamps); per-node CPU and resident memory during the mission
+and at idle afterwards (from /proc); executed vs planned makespan in schedule units and the
 wall-clock overhead of the mission.
 
 Run from the repository with the workspace sourced:
@@ -30,7 +30,8 @@ from fjsp_common.contract import (
     TASK_EVENTS_TOPIC,
 )
 from fjsp_msgs.msg import MissionStatus, Plan, RobotState, TaskEvent
-from fjsp_planner.fleet import Fleet, Listener
+from fjsp_planner.launcher.listener import Listener
+from fjsp_planner.launcher.supervision import Fleet
 from fjsp_planner.testing import DomainClaim
 
 LOCALHOST = {'ROS_AUTOMATIC_DISCOVERY_RANGE': 'LOCALHOST'}

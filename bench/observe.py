@@ -32,13 +32,6 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / 'test' / 'integration'))
 
-from browser import (  # noqa: E402
-    find_chromium,
-    free_port,
-    headless_browser,
-    wait_listening,
-)
-
 from fjsp_common.contract import (  # noqa: E402
     MODE_FROM_MSG,
     ROBOT_STATES_QOS,
@@ -46,6 +39,13 @@ from fjsp_common.contract import (  # noqa: E402
 )
 from fjsp_msgs.msg import MissionStatus, RobotState  # noqa: E402
 from fjsp_planner.testing import FleetHarness  # noqa: E402
+
+from browser import (  # noqa: E402
+    find_chromium,
+    free_port,
+    headless_browser,
+    wait_listening,
+)
 
 SCENARIO = REPO / 'config' / 'scenarios' / 'solar_panel.yaml'
 

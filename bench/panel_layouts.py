@@ -3,7 +3,7 @@
 Usage: python bench/panel_layouts.py [--panels 5] [--incumbent 848/3] [--solve-limit 60]
                                      [--time-limit 900] [--max-open N]
 
-The bound (`core/sequence_bound.py`) takes every set of panels where the slow-crossing robots
+The bound (`solving/bounds/sequence.py`) takes every set of panels where the slow-crossing robots
 (the paper's Assembler) may work, its *layout*, and is the least value over them. Searched
 together in a solve, they share its time limit; here each gets `--time-limit` seconds of its
 own and, by default, no cap on open orders, so that a layout that ends shows the most the
@@ -26,9 +26,9 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO / 'src' / 'fjsp_planner'))
 
-from fjsp_planner.core import sequence_bound  # noqa: E402
-from fjsp_planner.core.scenario import load_scenario  # noqa: E402
-from fjsp_planner.core.solve import solve  # noqa: E402
+from fjsp_planner.model.scenario import load_scenario  # noqa: E402
+from fjsp_planner.solving.bounds import sequence as sequence_bound  # noqa: E402
+from fjsp_planner.solving.solve import solve  # noqa: E402
 
 
 def main():

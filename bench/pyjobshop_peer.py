@@ -68,10 +68,10 @@ def run_peer(instance: str, time_limit: float, workers: int, panels: int = 1) ->
 def _load(instance: str, panels: int):
     sys.path.insert(0, str(REPO / 'src' / 'fjsp_planner'))
     if instance.endswith('.fjs'):
-        from fjsp_planner.core.fjs import load_fjs
+        from fjsp_planner.model.fjs import load_fjs
 
         return load_fjs(instance)
-    from fjsp_planner.core.scenario import load_scenario
+    from fjsp_planner.model.scenario import load_scenario
 
     return load_scenario(instance, panels=panels)
 

@@ -26,10 +26,10 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO / 'src' / 'fjsp_planner'))
 
-from fjsp_planner.core.mission import IMPROVE_REACH, LONGEST_SEARCH  # noqa: E402
-from fjsp_planner.core.replan import improve, repair, replan, simulated_state  # noqa: E402
-from fjsp_planner.core.scenario import load_scenario  # noqa: E402
-from fjsp_planner.core.solve import solve  # noqa: E402
+from fjsp_planner.execution.mission.controller import IMPROVE_REACH, LONGEST_SEARCH  # noqa: E402
+from fjsp_planner.execution.replan import improve, repair, replan, simulated_state  # noqa: E402
+from fjsp_planner.model.scenario import load_scenario  # noqa: E402
+from fjsp_planner.solving.solve import solve  # noqa: E402
 
 SCENARIO = REPO / 'config' / 'scenarios' / 'solar_panel.yaml'
 REPLAN_LIMIT = 0.7

@@ -33,14 +33,14 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import ortools  # noqa: E402
 
-from fjsp_planner.core.gantt import draw_gantt  # noqa: E402
-from fjsp_planner.core.mip import solve_mip  # noqa: E402
-from fjsp_planner.core.scenario import load_scenario  # noqa: E402
-from fjsp_planner.core.schedule import Status  # noqa: E402
-from fjsp_planner.core.solve import solve  # noqa: E402
-from fjsp_planner.core.validate import validate  # noqa: E402
+from fjsp_planner.model.scenario import load_scenario  # noqa: E402
+from fjsp_planner.model.schedule import Status  # noqa: E402
+from fjsp_planner.model.validate import validate  # noqa: E402
+from fjsp_planner.observe.plan_chart import draw_gantt  # noqa: E402
 from fjsp_planner.rl.env import AssemblyEnv, restrict  # noqa: E402
 from fjsp_planner.rl.qlearning import greedy_rollout, train  # noqa: E402
+from fjsp_planner.solving.mip import solve_mip  # noqa: E402
+from fjsp_planner.solving.solve import solve  # noqa: E402
 
 SCENARIO = REPO / 'config' / 'scenarios' / 'solar_panel.yaml'
 DOC = REPO / 'docs' / 'paper-reproduction.md'
@@ -339,11 +339,11 @@ def write_report(config, exact, rl, optimum, optimum_schedule, subset, wall, qui
         '## MIP (§IV) and CP-SAT',
         '',
         "MIP: the paper's model as printed, with its index slips corrected (listed in "
-        '`src/fjsp_planner/fjsp_planner/core/mip.py`), solved through OR-Tools `pywraplp` '
+        '`src/fjsp_planner/fjsp_planner/solving/mip.py`), solved through OR-Tools `pywraplp` '
         "with no warm start, times scaled to the exact 1/30 grid; for 2 panels also as "
         "`solve(solver='mip')` runs it, started from the greedy schedule (which also caps "
         "its horizon; its first solution is that start). CP-SAT: the project's "
-        'model (`core/cpsat/`) through `solve()`, which warm-starts it from the greedy '
+        'model (`solving/cpsat/`) through `solve()`, which warm-starts it from the greedy '
         'schedule. Gurobi 9 is not available here; its figures are quoted from the paper.',
         '',
     ]

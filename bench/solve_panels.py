@@ -16,9 +16,9 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO / 'src' / 'fjsp_planner'))
 
-from fjsp_planner.core.scenario import load_scenario  # noqa: E402
-from fjsp_planner.core.solve import solve  # noqa: E402
-from fjsp_planner.core.validate import validate  # noqa: E402
+from fjsp_planner.model.scenario import load_scenario  # noqa: E402
+from fjsp_planner.model.validate import validate  # noqa: E402
+from fjsp_planner.solving.solve import solve  # noqa: E402
 
 sys.path.insert(0, str(REPO / 'bench'))
 from pyjobshop_peer import run_peer  # noqa: E402

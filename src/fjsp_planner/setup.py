@@ -30,7 +30,7 @@ setup(
             'replay = fjsp_planner.observe.replay:run',
             'inject_fault = fjsp_planner.faults:main',
             'mission = fjsp_planner.missions:main',
-            'fleet = fjsp_planner.fleet:main',
+            'fleet = fjsp_planner.launcher.cli:main',
         ],
     },
 )

@@ -3,21 +3,20 @@ no traceback and no hang."""
 
 import os
 import subprocess
-from pathlib import Path
 
 import pytest
 
-SCENARIO = Path(__file__).resolve().parents[2] / 'config' / 'scenarios' / 'solar_panel.yaml'
+from repo_paths import PAPER
 
 
 @pytest.mark.parametrize(('command', 'code', 'message'), [
     (['run', 'fjsp_planner', 'planner_node', '--ros-args', '-p', 'scenario:=/no/such.yaml'],
      2, "parameter 'scenario'"),  # unreadable scenario file
-    (['run', 'fjsp_planner', 'planner_node', '--ros-args', '-p', f'scenario:={SCENARIO}',
+    (['run', 'fjsp_planner', 'planner_node', '--ros-args', '-p', f'scenario:={PAPER}',
       '-p', 'time_scale:=-1.0'], 2, "parameter 'time_scale' must be"),  # negative scale
     (['run', 'fjsp_planner', 'planner_node', '--ros-args', '-p', 'workers:=two'],
      2, "parameter 'workers' must be of type integer"),  # wrong parameter type
-    *[(['run', 'fjsp_planner', 'planner_node', '--ros-args', '-p', f'scenario:={SCENARIO}',
+    *[(['run', 'fjsp_planner', 'planner_node', '--ros-args', '-p', f'scenario:={PAPER}',
         '-p', f'{name}:={value}'], 2, f"parameter '{name}' must be within")
       for name, value in (('time_scale', '.inf'), ('robot_wait_timeout', '.nan'),
                           ('start_delay', '1e300'), ('workers', '999999'),

@@ -2,7 +2,6 @@
 
 import copy
 import time
-from pathlib import Path
 
 from fjsp_common.contract import (
     EVENTS_QOS,
@@ -13,12 +12,12 @@ from fjsp_common.contract import (
 )
 from fjsp_msgs.msg import Plan, RobotState, TaskEvent
 
-SCENARIO = Path(__file__).resolve().parents[2] / 'config' / 'scenarios' / 'solar_panel.yaml'
+from repo_paths import PAPER
 
 
 def test_bad_messages_are_ignored_and_counted(fjsp_fleet):
     # Slow enough (32 units * 0.15 s) that the bad messages land mid-mission.
-    fleet = fjsp_fleet(SCENARIO, time_scale=0.15).start()
+    fleet = fjsp_fleet(PAPER, time_scale=0.15).start()
     observer = fleet.observer
     # Each writer is discovered on its own: the planner's job-done may come before any
     # agent's event, so wait for both kinds.

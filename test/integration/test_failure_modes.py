@@ -3,25 +3,25 @@ request or redid work before it was fixed."""
 
 import threading
 import time
-from pathlib import Path
 
 from fjsp_common.contract import PLAN_TOPIC, agent_node_name
 from fjsp_msgs.msg import MissionEvent, MissionStatus, TaskEvent
 from fjsp_planner.faults import FaultError, inject_fault
 
-SCENARIO = Path(__file__).resolve().parents[2] / 'config' / 'scenarios' / 'solar_panel.yaml'
+from repo_paths import PAPER
+
 ROBOTS = ('Assembler', 'LSMS', 'MARC1', 'MARC2')
 
 
 def start(fjsp_fleet, **planner):
-    fleet = fjsp_fleet(SCENARIO, time_scale=0.15, planner=planner).start(monitor=False)
+    fleet = fjsp_fleet(PAPER, time_scale=0.15, planner=planner).start(monitor=False)
     fleet.wait_for(lambda o: o.status is not None and o.status.jobs_done >= 2, 40,
                    'the mission under way')
     return fleet, fleet.observer
 
 
 def test_a_burst_of_fault_requests_is_answered_every_one(fjsp_fleet):
-    fleet = fjsp_fleet(SCENARIO)
+    fleet = fjsp_fleet(PAPER)
     observer = fleet.observer
     fleet.start_agent('LSMS')
     fleet.wait_for(lambda o: 'LSMS' in o.robots, 20, 'the LSMS agent')
@@ -58,7 +58,7 @@ def test_failure_and_recovery_at_once_do_not_hang_the_mission(fjsp_fleet):
 def test_a_restarted_agent_is_believed(fjsp_fleet):
     """Its event ids must not repeat its previous process's, or its facts are dropped as
     duplicates and the mission stalls."""
-    fleet = fjsp_fleet(SCENARIO, time_scale=0.5, planner={'start_delay': 1.0}).start(
+    fleet = fjsp_fleet(PAPER, time_scale=0.5, planner={'start_delay': 1.0}).start(
         monitor=False)
     observer = fleet.observer
     # Killed on its first job (whichever the solver gave it), the LSMS's next process redoes
@@ -101,7 +101,7 @@ def test_no_robot_is_declared_offline_in_a_quiet_mission(fjsp_fleet):
 def test_jobs_done_while_replanning_are_not_done_again(fjsp_fleet):
     """Five panels at 0.01 s per unit: a re-plan takes long in schedule time, and robots
     finish jobs of the old plan while it is computed. None may be done a second time."""
-    fleet = fjsp_fleet(SCENARIO, panels=5, time_scale=0.01,
+    fleet = fjsp_fleet(PAPER, panels=5, time_scale=0.01,
                        planner={'time_limit': 10.0, 'replan_time_limit': 2.5}).start()
     fleet.wait_for(lambda o: o.status is not None and o.status.jobs_done >= 20, 180,
                    '20 of 60 jobs done')
@@ -114,7 +114,7 @@ def test_jobs_done_while_replanning_are_not_done_again(fjsp_fleet):
 def test_an_agent_that_never_gets_the_plan_is_planned_without_until_it_does(fjsp_fleet):
     """MARC2's agent reports, but its plan subscription hears nothing (remapped away, as a
     subscription that never matched the plan's writer): the mission must not wait on it."""
-    fleet = fjsp_fleet(SCENARIO, time_scale=0.15, planner={'plan_uptake_timeout': 3.0})
+    fleet = fjsp_fleet(PAPER, time_scale=0.15, planner={'plan_uptake_timeout': 3.0})
     for robot in ROBOTS[:3]:
         fleet.start_agent(robot)
     fleet.start_node(agent_node_name('MARC2'), 'robot_agents', 'robot_agent',

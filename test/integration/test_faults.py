@@ -5,18 +5,18 @@ The missions run at 0.1 s per schedule unit (the paper's 32 units take about 3 s
 can land mid-mission and a re-plan takes a few units of schedule time.
 """
 
-from pathlib import Path
 
 from fjsp_msgs.msg import MissionStatus, TaskEvent
 from fjsp_planner.testing import valid_events
 
-SCENARIO = Path(__file__).resolve().parents[2] / 'config' / 'scenarios' / 'solar_panel.yaml'
+from repo_paths import PAPER
+
 SLOW = 0.1
 """Wall seconds per schedule unit."""
 
 
 def start_mission(fjsp_fleet, **planner):
-    fleet = fjsp_fleet(SCENARIO, time_scale=SLOW, planner=planner).start()
+    fleet = fjsp_fleet(PAPER, time_scale=SLOW, planner=planner).start()
     robots = [r.name for r in fleet.problem.robots]
     fleet.wait_for(lambda o: o.plans and all(
         r in o.robots and o.robots[r].plan_revision >= 1 for r in robots), 40,

@@ -13,7 +13,8 @@ import pytest
 from fjsp_msgs.msg import MissionStatus
 from fjsp_planner.testing import Observer
 
-SCENARIO = Path(__file__).resolve().parents[2] / 'config' / 'scenarios' / 'solar_panel.yaml'
+from repo_paths import PAPER
+
 NODES = 6
 """The planner, the paper's four robots and the monitor."""
 
@@ -65,7 +66,7 @@ def still_running(nodes, timeout: float) -> set:
 
 
 def test_a_complete_mission_exits_0(tmp_path, ros_domain):
-    process = launcher(tmp_path, str(SCENARIO), '--exit-on-complete', '--time-scale', '0.03',
+    process = launcher(tmp_path, str(PAPER), '--exit-on-complete', '--time-scale', '0.03',
                        '--timeout', '120', domain=ros_domain)
     nodes = wait_for_nodes(process)
     out, err = process.communicate(timeout=180)
@@ -87,7 +88,7 @@ def test_no_node_outlives_the_launcher(tmp_path, how, ros_domain):
     domain = ros_domain
     observer = Observer(domain)
     try:
-        process = launcher(tmp_path, str(SCENARIO), '--time-scale', '0.1', domain=domain)
+        process = launcher(tmp_path, str(PAPER), '--time-scale', '0.1', domain=domain)
         nodes = wait_for_nodes(process)
         observer.wait_for(lambda o: o.status is not None and o.status.jobs_done >= 1
                           and o.status.state == MissionStatus.STATE_EXECUTING, 60,

@@ -2,21 +2,21 @@
 the mission ended, still catch up."""
 
 import time
-from pathlib import Path
 
 from rclpy.time import Time
 
 from fjsp_common.contract import ROBOT_STATES_QOS, ROBOT_STATES_TOPIC
 from fjsp_msgs.msg import MissionStatus, RobotState
-from fjsp_planner.fleet import Listener
+from fjsp_planner.launcher.listener import Listener
 
-SCENARIO = Path(__file__).resolve().parents[2] / 'config' / 'scenarios' / 'solar_panel.yaml'
+from repo_paths import PAPER
+
 ROBOTS = ('Assembler', 'LSMS', 'MARC1', 'MARC2')
 
 
 def test_agent_and_monitor_started_after_the_plan(fjsp_fleet, tmp_path):
     # MARC2 is missing: the planner waits 3 s for it, then plans without it, saying so.
-    fleet = fjsp_fleet(SCENARIO, time_scale=0.3, planner={'robot_wait_timeout': 3.0})
+    fleet = fjsp_fleet(PAPER, time_scale=0.3, planner={'robot_wait_timeout': 3.0})
     fleet.start_planner()
     for robot in ROBOTS[:3]:
         fleet.start_agent(robot)
@@ -48,7 +48,7 @@ def test_agent_and_monitor_started_after_the_plan(fjsp_fleet, tmp_path):
 def test_a_late_subscriber_gets_every_robots_state(fjsp_fleet):
     # Heartbeats every 10 s: after the mission the agents stay silent for seconds, so what a
     # late subscriber gets at once is what DDS kept for it, one latched state per agent.
-    fleet = fjsp_fleet(SCENARIO, agents={'heartbeat_period': 10.0},
+    fleet = fjsp_fleet(PAPER, agents={'heartbeat_period': 10.0},
                        planner={'heartbeat_timeout': 60.0}).start()
     fleet.wait_for(lambda o: o.complete(), 60, 'the mission to complete')
     late = Listener(fleet.domain, name='late_subscriber', discovery_range='LOCALHOST')

@@ -1,14 +1,14 @@
 """A whole mission over real processes: the planner and the paper's four robots, each played
 by its type-pinning executable (`assembler_agent`, `lsms_agent`, `marc_agent`)."""
 
-from pathlib import Path
 
 import pytest
 
 from fjsp_msgs.msg import MissionStatus, TaskEvent
 from fjsp_planner.testing import FleetHarness
 
-SCENARIO = Path(__file__).resolve().parents[2] / 'config' / 'scenarios' / 'solar_panel.yaml'
+from repo_paths import PAPER
+
 PAPER_AGENTS = {'Assembler': 'assembler_agent', 'LSMS': 'lsms_agent', 'MARC1': 'marc_agent',
                 'MARC2': 'marc_agent'}
 MAKESPAN_TOLERANCE = 0.01
@@ -19,7 +19,7 @@ is the rounding-up of reported ends (1e-6 units per leg or operation)."""
 @pytest.fixture(scope='module')
 def mission(tmp_path_factory):
     """One mission shared by this module's tests (each check reads the same run)."""
-    with FleetHarness(SCENARIO, out=tmp_path_factory.mktemp('mission')) as fleet:
+    with FleetHarness(PAPER, out=tmp_path_factory.mktemp('mission')) as fleet:
         fleet.start_planner()
         for robot, executable in PAPER_AGENTS.items():
             fleet.start_agent(robot, executable)

@@ -3,18 +3,18 @@ rejected goals, jobs added mid-mission, and a planner killed and restarted mid-m
 
 import time
 from collections import Counter
-from pathlib import Path
 
 import pytest
 import yaml
 
 from fjsp_common.contract import agent_node_name
 from fjsp_msgs.msg import MissionStatus, RobotState, TaskEvent
-from fjsp_planner.core.scenario import load_scenario
 from fjsp_planner.missions import MissionClient, MissionError
+from fjsp_planner.model.scenario import load_scenario
 from fjsp_planner.testing import Observer, executed_timeline, validate_executed
 
-SCENARIO = Path(__file__).resolve().parents[2] / 'config' / 'scenarios' / 'solar_panel.yaml'
+from repo_paths import PAPER
+
 ROBOTS = ('Assembler', 'LSMS', 'MARC1', 'MARC2')
 
 SLOW = 0.1
@@ -24,7 +24,7 @@ SLOW = 0.1
 @pytest.fixture
 def idle_fleet(fjsp_fleet):
     """An idle planner (no scenario: it waits for goals) and the paper's four agents."""
-    fleet = fjsp_fleet(SCENARIO, time_scale=SLOW)
+    fleet = fjsp_fleet(PAPER, time_scale=SLOW)
     fleet.start_planner(scenario='')
     for robot in ROBOTS:
         fleet.start_agent(robot)
@@ -81,25 +81,25 @@ def test_an_idle_planner_says_so(idle_fleet):
 
 
 def test_successive_missions_on_one_fleet(client, observer):
-    first = client.run(SCENARIO, timeout=90)
+    first = client.run(PAPER, timeout=90)
     assert first.complete, first
     assert (first.jobs_done, first.jobs_total) == (12, 12)
     assert abs(first.makespan - 32) < 1e-3
-    check_done_once(load_scenario(SCENARIO), observer, first.mission_id)
+    check_done_once(load_scenario(PAPER), observer, first.mission_id)
 
-    second = client.run(SCENARIO, panels=2, timeout=120)
+    second = client.run(PAPER, panels=2, timeout=120)
     assert second.complete, second
     assert second.mission_id != first.mission_id and second.jobs_done == 24
-    check_done_once(load_scenario(SCENARIO, panels=2), observer, second.mission_id)
+    check_done_once(load_scenario(PAPER, panels=2), observer, second.mission_id)
     # Revisions count per mission, and nothing of the first leaked into the second.
     plans, _ = of_mission(observer, second.mission_id)
     assert plans[0].revision == 1
 
 
 def test_goal_during_a_mission_and_broken_goal_are_rejected(client, observer):
-    running = client.submit(SCENARIO)
+    running = client.submit(PAPER)
     with pytest.raises(MissionError, match='one mission per fleet') as busy:
-        client.submit(SCENARIO)
+        client.submit(PAPER)
     assert running.mission_id in str(busy.value)
     broken = {'operation_types': {0: 'weld'}, 'robot_types': {'W': {'weld': 1}},
               'robots': [{'name': 'R1', 'type': 'Welder'}],
@@ -114,7 +114,7 @@ def test_goal_during_a_mission_and_broken_goal_are_rejected(client, observer):
 
 
 def test_cancel_leaves_the_fleet_idle_for_the_next_mission(client, observer):
-    mission = client.submit(SCENARIO)
+    mission = client.submit(PAPER)
     observer.wait_for(lambda o: o.status is not None
                       and o.status.mission_id == mission.mission_id
                       and o.status.jobs_done >= 2, 30, 'the mission under way')
@@ -127,9 +127,9 @@ def test_cancel_leaves_the_fleet_idle_for_the_next_mission(client, observer):
     assert any(e.kind == TaskEvent.KIND_ABORTED and e.reason == 'mission cancelled'
                for e in events) or not any(e.kind == TaskEvent.KIND_STARTED
                                            for e in events[-4:])
-    third = client.run(SCENARIO, timeout=90)
+    third = client.run(PAPER, timeout=90)
     assert third.complete and third.jobs_done == 12
-    check_done_once(load_scenario(SCENARIO), observer, third.mission_id)
+    check_done_once(load_scenario(PAPER), observer, third.mission_id)
 
 
 class _SlowToRegister:
@@ -163,16 +163,16 @@ def test_an_answer_back_before_its_request_is_filed_still_counts(client, observe
     request only after sending it (ros2/rclpy#1123); an answer the client's executor thread
     takes in between is lost, for a goal, a cancel or a result alike."""
     client._action._client_handle = _SlowToRegister(client._action._client_handle)
-    mission = client.submit(SCENARIO, timeout=5)
+    mission = client.submit(PAPER, timeout=5)
     mission.cancel(timeout=5)
     assert mission.result(timeout=10).state == 'cancelled'
 
 
-SECOND_PANEL = SCENARIO.parents[1] / 'fragments' / 'solar_panel_second_panel.yaml'
+SECOND_PANEL = PAPER.parents[1] / 'fragments' / 'solar_panel_second_panel.yaml'
 
 
 def test_a_second_panel_added_mid_mission(client, observer):
-    mission = client.submit(SCENARIO)
+    mission = client.submit(PAPER)
     observer.wait_for(lambda o: o.status is not None
                       and o.status.mission_id == mission.mission_id
                       and o.status.jobs_done >= 1, 30, 'the first panel under way')
@@ -185,16 +185,16 @@ def test_a_second_panel_added_mid_mission(client, observer):
     result = mission.result(timeout=120)
     assert result.complete and (result.jobs_done, result.jobs_total) == (24, 24), result
     _, events = of_mission(observer, mission.mission_id)
-    extended = load_scenario(SCENARIO, panels=1)
-    from fjsp_planner.core.extension import extend
+    extended = load_scenario(PAPER, panels=1)
+    from fjsp_planner.model.extension import extend
 
     extended, _ = extend(extended, SECOND_PANEL.read_text())
     check_done_once(extended, observer, mission.mission_id)
 
 
 def test_planner_killed_mid_mission_resumes_it(fjsp_fleet, tmp_path):
-    problem = load_scenario(SCENARIO)
-    fleet = fjsp_fleet(SCENARIO, time_scale=0.15,
+    problem = load_scenario(PAPER)
+    fleet = fjsp_fleet(PAPER, time_scale=0.15,
                        planner={'journal_dir': tmp_path / 'journal'}).start()
     observer = fleet.observer
     fleet.wait_for(lambda o: o.status is not None and o.status.jobs_done >= 3, 40,
@@ -222,7 +222,7 @@ def test_planner_killed_mid_mission_resumes_it(fjsp_fleet, tmp_path):
 def test_a_restarted_planner_publishes_its_last_plan_again(fjsp_fleet, tmp_path):
     """Killed while publishing a plan, the planner may have reached some subscribers and not
     others: restarted, it publishes that revision again, as it was, before re-planning."""
-    fleet = fjsp_fleet(SCENARIO, time_scale=SLOW,
+    fleet = fjsp_fleet(PAPER, time_scale=SLOW,
                        planner={'journal_dir': tmp_path / 'journal', 'robot_wait_timeout': 60.0})
     fleet.start()
     fleet.wait_for(lambda o: o.status is not None and o.status.jobs_done >= 1, 40,

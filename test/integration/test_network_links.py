@@ -1,5 +1,5 @@
 """The fleet across real network links: the planner on one host, each agent on a host of its
-own (network namespaces on a bridge, `fjsp_planner.hosts`), DDS discovering over the LAN.
+own (network namespaces on a bridge, `fjsp_planner.launcher.hosts`), DDS discovering over the LAN.
 A link is cut mid-mission as if its cable were pulled, then restored: the planner must see
 the robot go and come back, re-plan each time, and finish the mission with every job done
 exactly once and an executed timeline the validator accepts, whatever the robot on the
@@ -10,14 +10,14 @@ Skipped, saying why, where network namespaces cannot be created (not root, no `i
 
 import re
 import time
-from pathlib import Path
 
 import pytest
 
 from fjsp_common.contract import LATCHED_QOS, MISSION_STATUS_TOPIC
 from fjsp_msgs.msg import MissionEvent, MissionStatus, TaskEvent
 
-SCENARIO = Path(__file__).resolve().parents[2] / 'config' / 'scenarios' / 'solar_panel.yaml'
+from repo_paths import PAPER
+
 CUT_SCALE = 0.15
 """Wall seconds per schedule unit: two panels take about 10 s, room for a cut and a return."""
 
@@ -46,7 +46,7 @@ def lan_fleet(fjsp_network, fjsp_fleet):
     the mission went through."""
 
     def make(**options):
-        fleet = fjsp_fleet(SCENARIO, network=fjsp_network, **options)
+        fleet = fjsp_fleet(PAPER, network=fjsp_network, **options)
         observer = fleet.observer
         observer.states = []
         observer.subscribe(MissionStatus, MISSION_STATUS_TOPIC, LATCHED_QOS,

@@ -8,7 +8,6 @@ The mission runs at 0.1 s per schedule unit so that a failure lands mid-mission.
 import json
 import subprocess
 import time
-from pathlib import Path
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from mcap.reader import make_reader
@@ -17,7 +16,8 @@ from fjsp_msgs.msg import MissionStatus
 from fjsp_planner.missions import MissionClient
 from fjsp_planner.observe.recording import RecordingError, read_recording
 
-SCENARIO = Path(__file__).resolve().parents[2] / 'config' / 'scenarios' / 'solar_panel.yaml'
+from repo_paths import PAPER
+
 ROBOTS = ('Assembler', 'LSMS', 'MARC1', 'MARC2')
 
 SLOW = 0.1
@@ -64,7 +64,7 @@ def latest_revision(observer) -> int:
 
 def test_recording_replays_into_the_history_the_monitor_built(fjsp_fleet, tmp_path):
     out, replayed = tmp_path / 'out', tmp_path / 'replayed'
-    fleet = fjsp_fleet(SCENARIO, time_scale=SLOW)
+    fleet = fjsp_fleet(PAPER, time_scale=SLOW)
     observer = fleet.observer
     fleet.start_node('recorder', 'fjsp_planner', 'recorder',
                      {'out_dir': out, 'file_name': 'mission.mcap', 'flush_period': 0.5})
@@ -82,7 +82,7 @@ def test_recording_replays_into_the_history_the_monitor_built(fjsp_fleet, tmp_pa
         assert time.monotonic() < deadline, 'the recorder or the monitor did not hear the fleet'
         time.sleep(0.2)
     with MissionClient(domain_id=fleet.domain) as client:
-        client.submit(SCENARIO)
+        client.submit(PAPER)
     fleet.wait_for(lambda o: o.plans and all(
         r in o.robots and o.robots[r].plan_revision >= 1 for r in ROBOTS), 60,
         'every agent to follow the first plan')
@@ -139,7 +139,7 @@ def test_recording_replays_into_the_history_the_monitor_built(fjsp_fleet, tmp_pa
 
 
 def test_diagnostics_show_failed_and_offline_robots(fjsp_fleet):
-    fleet = fjsp_fleet(SCENARIO, time_scale=SLOW)
+    fleet = fjsp_fleet(PAPER, time_scale=SLOW)
     observer = fleet.observer
     statuses: list[DiagnosticStatus] = []
 
@@ -172,7 +172,7 @@ def test_diagnostics_show_failed_and_offline_robots(fjsp_fleet):
 
 
 def test_ros2_topic_list_and_echo(fjsp_fleet):
-    fleet = fjsp_fleet(SCENARIO, time_scale=SLOW)
+    fleet = fjsp_fleet(PAPER, time_scale=SLOW)
     fleet.start_planner()
     fleet.wait_for(lambda o: o.status is not None, 30, "the planner's first status")
 

@@ -2,14 +2,13 @@
 fleet runs, a robot fails mid-mission, and the page shows what a person watching it must see.
 """
 
-from pathlib import Path
-
 import pytest
-from browser import find_chromium, free_port, headless_browser, wait_listening
 
 from fjsp_msgs.msg import MissionStatus
 
-SCENARIO = Path(__file__).resolve().parents[2] / 'config' / 'scenarios' / 'solar_panel.yaml'
+from browser import find_chromium, free_port, headless_browser, wait_listening
+from repo_paths import PAPER
+
 ROBOTS = ('Assembler', 'LSMS', 'MARC1', 'MARC2')
 
 if find_chromium() is None:
@@ -54,7 +53,7 @@ def story(page) -> list[str]:
 
 def test_live_page_follows_a_mission_through_a_failure(fjsp_fleet, tmp_path):
     port = free_port()
-    fleet = fjsp_fleet(SCENARIO, time_scale=SLOW)
+    fleet = fjsp_fleet(PAPER, time_scale=SLOW)
     fleet.start_monitor(out_dir=tmp_path, web_port=port)
     fleet.start_planner()
     for robot in ROBOTS:

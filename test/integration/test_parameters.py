@@ -4,7 +4,6 @@ launcher's own options win over it, and a set through a node's parameter service
 descriptor forbids (out of range, read-only) is refused with a reason."""
 
 import time
-from pathlib import Path
 
 import pytest
 from rcl_interfaces.srv import GetParameters, SetParameters
@@ -12,7 +11,8 @@ from rclpy.parameter import Parameter, parameter_value_to_python
 
 from fjsp_planner.testing import FleetHarness
 
-REPO = Path(__file__).resolve().parents[2]
+from repo_paths import REPO
+
 SCENARIO = REPO / 'config' / 'scenarios' / 'solar_panel.yaml'
 PARAMS = REPO / 'config' / 'params' / 'paper_demo.yaml'
 

@@ -1,13 +1,12 @@
 """What a revision's plan message tells the agents, built from the domain core's objects."""
 
 import dataclasses
-from pathlib import Path
 
-from fjsp_planner.core.scenario import load_scenario
-from fjsp_planner.core.solve import solve
+from fjsp_planner.model.scenario import load_scenario
 from fjsp_planner.nodes.conversions import plan_msg
+from fjsp_planner.solving.solve import solve
 
-SCENARIO = Path(__file__).resolve().parents[2] / 'config' / 'scenarios' / 'solar_panel.yaml'
+from repo_paths import PAPER
 
 
 def test_a_revision_names_the_predecessors_done_before_it():
@@ -15,7 +14,7 @@ def test_a_revision_names_the_predecessors_done_before_it():
     with its robots there since before M2 ended, so its task still names both: the agents
     start it no earlier than M2's reported end (a restarted planner's revision left M2 out
     and they started `Ja` at 2, before M2's end at 2.000002)."""
-    scenario = load_scenario(SCENARIO)
+    scenario = load_scenario(PAPER)
     done = {'M1', 'M2'}
     posed = dataclasses.replace(
         scenario, jobs=tuple(j for j in scenario.jobs if j.name not in done),
@@ -32,7 +31,7 @@ def test_every_robot_is_placed_where_the_plan_starts_it():
     """A robot the plan gives no task still learns where it stands (the scenario's start, or
     where a re-plan has it); one the scenario may start anywhere, or one left out, gets no
     place."""
-    scenario = load_scenario(SCENARIO)
+    scenario = load_scenario(PAPER)
     placed = dataclasses.replace(scenario, robots=tuple(
         dataclasses.replace(r, start_location='Jd') if r.name == 'MARC2' else r
         for r in scenario.robots))

@@ -2,16 +2,16 @@
 have, shows on mission_status with a reason naming the robot, and the mission goes on
 without it where it can."""
 
-from pathlib import Path
 
 from fjsp_msgs.msg import MissionStatus
 
-SCENARIO = Path(__file__).resolve().parents[2] / 'config' / 'scenarios' / 'solar_panel.yaml'
+from repo_paths import PAPER
+
 ROBOTS = ('Assembler', 'LSMS', 'MARC1', 'MARC2')
 
 
 def test_type_mismatch_and_unknown_agent_reach_mission_status(fjsp_fleet):
-    fleet = fjsp_fleet(SCENARIO, time_scale=0.1)
+    fleet = fjsp_fleet(PAPER, time_scale=0.1)
     observer = fleet.observer
     fleet.start_planner()
     for robot in ROBOTS:

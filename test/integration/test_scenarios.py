@@ -3,13 +3,13 @@ own robot types played by the generic agent, robots leaving from their start loc
 earlier than their release times, alternative plans, precedence and holding arcs, within one
 place and across two (holders carry the part along their leg)."""
 
-from pathlib import Path
 
 import pytest
 
 from fjsp_msgs.msg import TaskEvent
 
-SCENARIOS = Path(__file__).resolve().parents[2] / 'config' / 'scenarios'
+from repo_paths import SCENARIOS
+
 PAPER_TYPES = {'Assembler', 'MARC', 'LSMS'}
 
 

@@ -5,7 +5,6 @@ planned. Signing itself is checked first, without processes."""
 import copy
 import math
 import time
-from pathlib import Path
 
 import pytest
 
@@ -20,7 +19,8 @@ from fjsp_common.contract import (
 from fjsp_msgs.msg import MissionStatus, Plan, RobotState, TaskEvent
 from fjsp_planner.faults import FaultError, inject_fault
 
-SCENARIO = Path(__file__).resolve().parents[2] / 'config' / 'scenarios' / 'solar_panel.yaml'
+from repo_paths import PAPER
+
 ROBOTS = ('Assembler', 'LSMS', 'MARC1', 'MARC2')
 
 
@@ -81,7 +81,7 @@ def test_new_keys_are_private_and_distinct(tmp_path):
 # --- a fleet under attack -------------------------------------------------------------------
 
 def start_fleet(fjsp_fleet, key_file, **planner):
-    fleet = fjsp_fleet(SCENARIO, time_scale=0.15,
+    fleet = fjsp_fleet(PAPER, time_scale=0.15,
                        planner={'fleet_key_file': key_file, **planner},
                        agents={'fleet_key_file': key_file}).start()
     fleet.wait_for(lambda o: o.status is not None and o.status.jobs_done >= 1, 40,

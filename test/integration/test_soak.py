@@ -23,9 +23,9 @@ from pathlib import Path
 import pytest
 
 from fjsp_msgs.msg import MissionStatus, RobotState, TaskEvent
-from fjsp_planner.core.scenario import load_scenario
 from fjsp_planner.faults import FaultError
 from fjsp_planner.missions import MissionClient, MissionError
+from fjsp_planner.model.scenario import load_scenario
 from fjsp_planner.testing import (
     FleetHarness,
     executed_timeline,
@@ -35,7 +35,8 @@ from fjsp_planner.testing import (
 )
 from robot_agents.agent_node import agent_node_name
 
-SCENARIOS = Path(__file__).resolve().parents[2] / 'config' / 'scenarios'
+from repo_paths import SCENARIOS
+
 GROUPS = (('solar_panel.yaml', (1, 2)), ('truss.yaml', (1,)), ('antenna.yaml', (1,)))
 """One fleet per scenario (a fleet runs one scenario's robots); its missions' panel counts
 are drawn from the tuple."""

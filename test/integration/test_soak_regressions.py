@@ -2,13 +2,12 @@
 its own that reproduces it on purpose."""
 
 import time
-from pathlib import Path
 
 from fjsp_msgs.msg import MissionStatus, RobotState, TaskEvent
 from fjsp_planner.testing import valid_events
 from robot_agents.agent_node import agent_node_name
 
-SCENARIOS = Path(__file__).resolve().parents[2] / 'config' / 'scenarios'
+from repo_paths import SCENARIOS
 
 
 def test_a_planner_killed_just_after_declaring_a_job_done_does_not_declare_it_again(

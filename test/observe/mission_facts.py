@@ -28,6 +28,8 @@ from fjsp_planner.observe.recording import (
     msg_files_under,
 )
 
+from repo_paths import REPO
+
 START = 1_000_000.0
 MISSION = 'demo-1'
 ROBOTS = (('A', 'Arm'), ('B', 'Arm'), ('C', 'Rover'))
@@ -146,7 +148,6 @@ def faulty_mission() -> list:
     return facts
 
 
-REPO = Path(__file__).resolve().parents[2]
 READ_MSG = msg_files_under(REPO / 'src', Path(sys.prefix) / 'share')
 TOPICS = {PlanFact: ('/plan', 'Plan'), TaskEventFact: ('/task_events', 'TaskEvent'),
           RobotStateFact: ('/robot_states', 'RobotState'),

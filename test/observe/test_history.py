@@ -4,6 +4,11 @@ spans, counts against the planner's status, the story, and independence from arr
 import random
 
 import pytest
+
+from fjsp_common.vocabulary import EventKind, MissionEventKind, MissionState, RobotMode
+from fjsp_planner.observe.history import FleetHistory, Outcome
+from fjsp_planner.observe.story import story
+
 from mission_facts import (
     MISSION,
     START,
@@ -18,10 +23,6 @@ from mission_facts import (
     task,
     work,
 )
-
-from fjsp_common.vocabulary import EventKind, MissionEventKind, MissionState, RobotMode
-from fjsp_planner.observe.history import FleetHistory, Outcome
-from fjsp_planner.observe.story import story
 
 
 def history_of(facts, timeout=1.0) -> FleetHistory:

@@ -7,7 +7,6 @@ import re
 
 import pytest
 from mcap.reader import make_reader
-from mission_facts import MISSION, READ_MSG, REPO, faulty_mission, record
 
 from fjsp_planner.observe.history import FleetHistory
 from fjsp_planner.observe.recording import (
@@ -17,6 +16,8 @@ from fjsp_planner.observe.recording import (
     replay,
 )
 from fjsp_planner.observe.story import story
+
+from mission_facts import MISSION, READ_MSG, REPO, faulty_mission, record
 
 
 def test_definitions_append_each_dependency_once_as_rosbag2_does():

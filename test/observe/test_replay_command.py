@@ -2,9 +2,10 @@
 answers to bad input (exit 1 with a one-line reason, exit 2 for bad arguments)."""
 
 import pytest
-from mission_facts import MISSION, faulty_mission, record
 
 from fjsp_planner.observe.replay import main
+
+from mission_facts import MISSION, faulty_mission, record
 
 
 def test_replay_prints_the_summary_and_story_and_draws_the_chart(tmp_path, capsys):

@@ -3,12 +3,12 @@ timeline drawn by the page and the PNG, terminal frames printed only on change."
 
 import math
 
-from mission_facts import MISSION, at, event, faulty_mission, heartbeats, plan, state, task, work
-
 from fjsp_common.vocabulary import EventKind, RobotMode
 from fjsp_planner.observe import text, views
-from fjsp_planner.observe.gantt import write_mission
 from fjsp_planner.observe.history import FleetHistory
+from fjsp_planner.observe.mission_chart import write_mission
+
+from mission_facts import MISSION, at, event, faulty_mission, heartbeats, plan, state, task, work
 
 
 def fleet_of(facts) -> FleetHistory:

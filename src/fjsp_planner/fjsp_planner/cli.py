@@ -17,10 +17,10 @@ import threading
 from fractions import Fraction
 from pathlib import Path
 
-from fjsp_planner.core.limits import MAX_WORKERS
-from fjsp_planner.core.problem import ProblemError
-from fjsp_planner.core.schedule import Result
-from fjsp_planner.core.validate import validate
+from fjsp_planner.model.limits import MAX_WORKERS
+from fjsp_planner.model.problem import ProblemError
+from fjsp_planner.model.schedule import Result
+from fjsp_planner.model.validate import validate
 
 EXIT_BAD_INPUT = 2
 EXIT_INVALID_SCHEDULE = 3
@@ -33,7 +33,7 @@ def main(argv=None) -> int:
     for signum in (signal.SIGINT, signal.SIGTERM):
         signal.signal(signum, _interrupted)
     # Imported after the handlers are in place: loading OR-Tools takes a noticeable moment.
-    from fjsp_planner.core.solve import SOLVERS
+    from fjsp_planner.solving.solve import SOLVERS
 
     parser = argparse.ArgumentParser(
         prog='fjsp-solve', description='Plan which robot does what, when, for a scenario '
@@ -85,7 +85,7 @@ def _in_worker(work) -> int:
 
 def _plan(args) -> int:
     global _stage
-    from fjsp_planner.core.solve import solve
+    from fjsp_planner.solving.solve import solve
 
     _stage = 'loading the scenario'
     try:
@@ -114,7 +114,7 @@ def _plan(args) -> int:
         if args.json:
             args.json.write_text(json.dumps(result_json(problem, result), indent=2) + '\n')
         if args.gantt and result.schedule is not None:
-            from fjsp_planner.core.gantt import draw_gantt
+            from fjsp_planner.observe.plan_chart import draw_gantt
 
             draw_gantt(problem, result.schedule, args.gantt,
                        title=f'{problem.name}: makespan {_number(result.makespan):g}')
@@ -127,12 +127,12 @@ def _plan(args) -> int:
 def _load(args):
     path = Path(args.scenario)
     if path.suffix == '.fjs':
-        from fjsp_planner.core.fjs import load_fjs
-        from fjsp_planner.core.scenario import repeat_panels
+        from fjsp_planner.model.fjs import load_fjs
+        from fjsp_planner.model.scenario import repeat_panels
 
         problem = load_fjs(path)
         return repeat_panels(problem, args.panels or 1, args.shift or 0)
-    from fjsp_planner.core.scenario import load_scenario
+    from fjsp_planner.model.scenario import load_scenario
 
     return load_scenario(path, panels=args.panels, shift=args.shift)
 
@@ -216,7 +216,7 @@ def _positive(text):
 
 
 def _non_negative(text):
-    from fjsp_planner.core import limits
+    from fjsp_planner.model import limits
 
     try:
         return limits.number(text, 'shift', Fraction(0), limits.MAX_TIME)

@@ -48,13 +48,14 @@ from fjsp_common.contract import (
     TASK_EVENTS_TOPIC,
 )
 from fjsp_msgs.msg import JobStates, MissionEvent, MissionStatus, Plan, RobotState, TaskEvent
-from fjsp_planner.core.problem import Problem
-from fjsp_planner.core.schedule import JobAssignment, Schedule
-from fjsp_planner.core.tracking import relaxed_distances
-from fjsp_planner.core.validate import validate
+from fjsp_planner.execution.tracking import relaxed_distances
 from fjsp_planner.faults import inject_fault
-from fjsp_planner.fleet import PLANNER_NODE, Fleet, Listener, _environment, find_executable
-from fjsp_planner.hosts import HostsUnavailableError, Network
+from fjsp_planner.launcher.hosts import HostsUnavailableError, Network
+from fjsp_planner.launcher.listener import Listener, environment
+from fjsp_planner.launcher.supervision import PLANNER_NODE, Fleet, find_executable
+from fjsp_planner.model.problem import Problem
+from fjsp_planner.model.schedule import JobAssignment, Schedule
+from fjsp_planner.model.validate import validate
 from robot_agents.agent_node import agent_node_name
 
 TEST_TIME_SCALE = 0.03
@@ -111,7 +112,7 @@ class Observer(Listener):
         host only)."""
         dds = {'ROS_AUTOMATIC_DISCOVERY_RANGE': DISCOVERY_RANGE, **(dds or {})}
         # Fast DDS reads its transports when the node's participant is made, after init.
-        with _environment(**dds):
+        with environment(**dds):
             super().__init__(domain, name='test_observer',
                              discovery_range=dds['ROS_AUTOMATIC_DISCOVERY_RANGE'])
         self.plans: list[Plan] = []
@@ -181,7 +182,7 @@ class FleetHarness(Fleet):
     """A `Fleet` on a private domain with an `observer` that records its topics from before
     the first node starts. Defaults suit tests: TEST_TIME_SCALE, TEST_PLANNER, no monitor.
 
-    With a `network` (`fjsp_planner.hosts.Network`), each node runs on a host of that LAN:
+    With a `network` (`fjsp_planner.launcher.hosts.Network`), each node runs on a host of that LAN:
     the planner and the monitor on CONTROL_HOST, each agent on a host named after its robot
     (made when the node first starts), discovering each other by multicast (ACROSS_HOSTS).
     The observer stays on this machine, which is on the LAN too."""
@@ -359,8 +360,8 @@ def _how_it_ended(code: int) -> str:
 
 @pytest.fixture
 def fjsp_network():
-    """A LAN of simulated hosts for this test (`fjsp_planner.hosts.Network`), removed after
-    it; pass it to `fjsp_fleet(..., network=...)`. Skips the test, saying why, where network
+    """A LAN of simulated hosts for this test (`fjsp_planner.launcher.hosts.Network`), removed
+    after it; pass it to `fjsp_fleet(..., network=...)`. Skips the test, saying why, where network
     namespaces cannot be created (not root, no `ip`, no CAP_NET_ADMIN)."""
     try:
         network = Network()

@@ -3,9 +3,9 @@
 import math
 
 from fjsp_msgs.msg import JobState, Plan, PlanTask, RobotPlan
-from fjsp_planner.core.problem import Problem
-from fjsp_planner.core.schedule import Result, Schedule
-from fjsp_planner.core.tracking import MissionTracker
+from fjsp_planner.execution.tracking import MissionTracker
+from fjsp_planner.model.problem import Problem
+from fjsp_planner.model.schedule import Result, Schedule
 
 
 def _float(value) -> float:

@@ -41,8 +41,8 @@ from fjsp_msgs.msg import MissionEvent, MissionStatus, Plan, RobotState, TaskEve
 from fjsp_planner.observe import text, views
 from fjsp_planner.observe.dashboard import Dashboard
 from fjsp_planner.observe.facts import Decoder, UnreadableMessageError
-from fjsp_planner.observe.gantt import write_mission
 from fjsp_planner.observe.history import FleetHistory, MissionHistory, Outcome
+from fjsp_planner.observe.mission_chart import write_mission
 from fjsp_planner.workspace import default_out_dir, safe_file_name
 
 DECODER = Decoder.from_classes(RobotState, TaskEvent, MissionStatus, MissionEvent)

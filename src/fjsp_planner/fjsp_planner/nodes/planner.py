@@ -1,4 +1,4 @@
-"""The planner node: ROS plumbing around the mission controller (`core/mission.py`).
+"""The planner node: ROS plumbing around the mission controller (`execution/mission/controller.py`).
 
 It turns robot states and task events into controller inputs, runs the solves the controller
 asks for in a worker thread (a guard condition wakes the executor the moment one finishes),
@@ -55,8 +55,7 @@ from fjsp_common.vocabulary import MissionEventKind, MissionState
 from fjsp_msgs.action import RunMission
 from fjsp_msgs.msg import JobStates, MissionEvent, MissionStatus, Plan, RobotState, TaskEvent
 from fjsp_msgs.srv import AddJobs, CancelMission
-from fjsp_planner.core.extension import extend
-from fjsp_planner.core.journal import (
+from fjsp_planner.execution.journal import (
     DoneRecord,
     EndRecord,
     JobsAddedRecord,
@@ -66,7 +65,7 @@ from fjsp_planner.core.journal import (
     journal_path,
     journals,
 )
-from fjsp_planner.core.mission import (
+from fjsp_planner.execution.mission.controller import (
     EventReport,
     JobDone,
     MissionController,
@@ -77,12 +76,13 @@ from fjsp_planner.core.mission import (
     Settings,
     Solve,
 )
-from fjsp_planner.core.problem import ProblemError
-from fjsp_planner.core.replan import improve, repair
-from fjsp_planner.core.scenario import load_scenario, scenario_from_text
-from fjsp_planner.core.solve import SOLVERS, solve
-from fjsp_planner.core.tracking import Ignored
+from fjsp_planner.execution.replan import improve, repair
+from fjsp_planner.execution.tracking import Ignored
+from fjsp_planner.model.extension import extend
+from fjsp_planner.model.problem import ProblemError
+from fjsp_planner.model.scenario import load_scenario, scenario_from_text
 from fjsp_planner.nodes.conversions import cancel_msg, job_states, plan_msg
+from fjsp_planner.solving.solve import SOLVERS, solve
 
 ANSWERS_KEPT = 256
 """Answers kept per service for requests that are resent."""

@@ -12,7 +12,7 @@ import sys
 from pathlib import Path
 
 from fjsp_planner.observe import text, views
-from fjsp_planner.observe.gantt import write_mission
+from fjsp_planner.observe.mission_chart import write_mission
 from fjsp_planner.observe.recording import RecordingError, replay
 from fjsp_planner.workspace import safe_file_name
 

@@ -29,8 +29,8 @@ from fractions import Fraction
 import gymnasium
 from gymnasium import spaces
 
-from fjsp_planner.core.problem import Problem
-from fjsp_planner.core.schedule import JobAssignment, Schedule
+from fjsp_planner.model.problem import Problem
+from fjsp_planner.model.schedule import JobAssignment, Schedule
 
 PENALTY = 10_000
 MAX_ASSIGNMENTS = 100_000

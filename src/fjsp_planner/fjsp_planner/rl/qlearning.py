@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from fjsp_planner.core.schedule import Schedule
+from fjsp_planner.model.schedule import Schedule
 
 
 @dataclass

@@ -1,0 +1,586 @@
+"""Mission execution as the planner sees it, from the robots' reports (no ROS).
+
+Times are schedule units since the mission start. The tracker turns task events into the
+facts re-planning needs (`execution_state`: done and running jobs, where each robot is and
+when it is free, when it last failed), the executed timeline (`executed_schedule`, and what
+it breaks: `violations`), a projected makespan and the operations running late (`overruns`),
+and which robots failed, even briefly, since a plan revision (`failed_since`). Every report it
+cannot use (malformed, out of order, naming what does not exist) is classified and counted,
+never raised: a message must not crash the planner.
+
+A plan revision either continues a job (it was under way) or starts it afresh: reports about
+a job made under a revision older than the one that last started it no longer count.
+"""
+
+import dataclasses
+import math
+import numbers
+from collections import Counter
+from dataclasses import dataclass, field
+from enum import StrEnum
+from fractions import Fraction
+
+from fjsp_common.vocabulary import EventKind, RobotMode
+from fjsp_planner.execution.replan import ExecutionState, RobotState
+from fjsp_planner.model.limits import shown
+from fjsp_planner.model.problem import Problem
+from fjsp_planner.model.schedule import JobAssignment, Schedule
+from fjsp_planner.model.validate import validate
+
+
+class Ignored(StrEnum):
+    """Why a report was not used."""
+
+    STALE = 'stale'
+    DUPLICATE = 'duplicate'
+    UNKNOWN = 'unknown'
+
+
+UNHEALTHY_MODES = frozenset({RobotMode.FAILED, RobotMode.OFFLINE})
+ROBOT_EVENTS = frozenset(EventKind) - {EventKind.JOB_DONE}
+"""What robots report; only the planner declares a job done."""
+
+MAX_REPORTED_TIME = 1e12
+"""No mission within docs/scenario-format.md's limits lasts longer (1000 jobs, each at most
+1e6 units of work and 1e6 of travel, delayed up to 1000 times): a later time is a bad report,
+and would overflow the solvers when re-planning from it."""
+
+
+@dataclass
+class JobRecord:
+    """What has been reported about one job since the revision that last started it."""
+
+    name: str
+    since_revision: int = 0
+    arrived: dict[str, float] = field(default_factory=dict)
+    started: dict[str, float] = field(default_factory=dict)
+    operation_done: dict[str, float] = field(default_factory=dict)
+    end: float | None = None
+    aborted: bool = False
+    """A robot on it failed while working: it waits for a new revision to be redone."""
+    done_as: JobAssignment | None = None
+    """The plan and robots it was completed with."""
+
+    @property
+    def start(self) -> float | None:
+        return min(self.started.values()) if self.started else None
+
+    @property
+    def begun(self) -> bool:
+        """A robot started it, or it is done."""
+        return bool(self.started) or self.end is not None
+
+
+@dataclass
+class RobotRecord:
+    name: str
+    mode: str = ''
+    location: str = ''
+    destination: str = ''
+    busy_until: float = math.nan
+    current_job: str = ''
+    reported: bool = False
+    failures: int = 0
+    """Transitions from healthy to failed or offline, however brief."""
+    last_failure_at: float | None = None
+    """When it last became failed or offline (schedule units); None if it never did."""
+
+    @property
+    def healthy(self) -> bool:
+        """Failed or offline robots are not; one that has not reported yet is taken to be
+        (it gets its tasks when it joins)."""
+        return self.mode not in UNHEALTHY_MODES
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """The result of one report: ignored (with why), or used; maybe completing a job."""
+
+    ignored: Ignored | None = None
+    reason: str = ''
+    job_done: tuple[str, float] | None = None
+    repeated: bool = False
+    """Ignored for a reason already counted and logged (an unknown robot's heartbeats)."""
+
+
+class MissionTracker:
+    def __init__(self, problem: Problem):
+        self.problem = problem
+        self.plan: Schedule | None = None
+        self.revision = 0
+        self.jobs = {j.name: JobRecord(j.name) for j in problem.jobs}
+        self.robots = {r.name: RobotRecord(r.name) for r in problem.robots}
+        self.ignored = Counter()
+        self._event_ids: set[str] = set()
+        self._repeated: set[str] = set()
+        """Reasons of robot states already counted: heartbeats repeat them every period."""
+        self._latest = 0.0
+        """The latest time any event used reported: dates failures reported without one."""
+        self._failures_at: dict[int, dict[str, int]] = {}
+        """Plan revision -> each robot's failure count when it was set."""
+        self._locations = frozenset(problem.locations())
+
+    # --- plans -------------------------------------------------------------------------
+
+    def set_plan(self, schedule: Schedule, revision: int, continued=frozenset()) -> None:
+        """Follow a new plan revision.
+
+        Its jobs not `continued` start afresh: what was reported about them is forgotten,
+        and reports made under an older revision are ignored from now on. What was reported
+        about jobs the revision leaves out (done before it) stays.
+        """
+        if revision <= self.revision:
+            raise ValueError(f'plan revision {revision} is not newer than {self.revision}')
+        unknown = sorted(set(continued) - set(schedule.jobs))
+        if unknown:
+            raise ValueError('continued job(s) not in the plan: ' + ', '.join(unknown))
+        for name in schedule.jobs:
+            if name not in continued:
+                self.jobs[name] = JobRecord(name, since_revision=revision)
+        self.plan, self.revision = schedule, revision
+        self._failures_at[revision] = {name: r.failures for name, r in self.robots.items()}
+
+    def failed_since(self, revision: int) -> frozenset[str]:
+        """Robots that became failed or offline at least once since plan `revision` was set,
+        whether or not they are healthy again. A revision never set (0: before the first
+        plan) counts every failure since the tracker began."""
+        before = self._failures_at.get(revision, {})
+        return frozenset(name for name, r in self.robots.items()
+                         if r.failures > before.get(name, 0))
+
+    def extend(self, problem: Problem) -> None:
+        """The mission grew to `problem` (jobs added): its new jobs are tracked too."""
+        self.problem = problem
+        self._locations = set(problem.locations())
+        for job in problem.jobs:
+            self.jobs.setdefault(job.name, JobRecord(job.name, since_revision=self.revision))
+
+    def restore_done(self, assignment: JobAssignment) -> None:
+        """A job declared done before the planner restarted, as its journal kept it."""
+        record = self.jobs[assignment.job]
+        record.started = dict.fromkeys(assignment.robots, float(assignment.start))
+        record.operation_done = dict.fromkeys(assignment.robots, float(assignment.end))
+        record.end, record.aborted, record.done_as = float(assignment.end), False, assignment
+
+    # --- reports -----------------------------------------------------------------------
+
+    def record_event(self, event_id: str, kind: EventKind, robot: str, job: str,
+                     revision: int, time: float) -> Outcome:
+        """Use one task event of an agent; classify it if it cannot be used. Never raises,
+        whatever the arguments."""
+        outcome = self._check_event(event_id, kind, robot, job, revision, time)
+        if outcome is None:
+            kind = EventKind(kind)
+            outcome = self._check_order(event_id, kind, robot, job, time)
+        if outcome is not None:
+            self.ignored[outcome.ignored] += 1
+            return outcome
+        self._event_ids.add(event_id)
+        self._latest = max(self._latest, time)
+        record = self.jobs[job]
+        facts = {EventKind.ARRIVED: record.arrived, EventKind.STARTED: record.started,
+                 EventKind.OPERATION_DONE: record.operation_done}
+        if kind == EventKind.ABORTED:
+            if record.end is not None:
+                return Outcome()
+            self.jobs[job] = JobRecord(job, since_revision=record.since_revision, aborted=True)
+            return Outcome()
+        if robot in facts[kind] or record.end is not None:
+            self.ignored[Ignored.DUPLICATE] += 1
+            return Outcome(Ignored.DUPLICATE, f"'{robot}' already reported {kind} for job "
+                                              f"'{job}' (event {shown(event_id)})")
+        facts[kind][robot] = time
+        if kind == EventKind.OPERATION_DONE:
+            robots = self.plan.jobs[job].robots
+            if all(r in record.operation_done for r in robots):
+                record.end = max(record.operation_done[r] for r in robots)
+                planned = self.plan.jobs[job]
+                record.done_as = JobAssignment(job, planned.plan, Fraction(record.start),
+                                               Fraction(record.end), dict(robots))
+                return Outcome(job_done=(job, record.end))
+        return Outcome()
+
+    def _check_event(self, event_id, kind, robot, job, revision, time) -> Outcome | None:
+        if not isinstance(event_id, str):
+            return Outcome(Ignored.UNKNOWN, f'invalid event id {shown(event_id)}')
+        what = f'event {shown(event_id)}'      # an id of a megabyte is not logged whole
+        if self.plan is None:
+            return Outcome(Ignored.STALE, f'{what} arrived before any plan')
+        if event_id in self._event_ids:
+            return Outcome(Ignored.DUPLICATE, f'{what} was already received')
+        if not isinstance(kind, str) or kind not in ROBOT_EVENTS:
+            return Outcome(Ignored.UNKNOWN, f'{what} has unknown event kind '
+                                            f'{shown(kind)}')
+        if not isinstance(robot, str) or robot not in self.robots:
+            return Outcome(Ignored.UNKNOWN, f'{what} names unknown robot '
+                                            f'{shown(robot)}')
+        if not isinstance(job, str) or job not in self.jobs:
+            return Outcome(Ignored.UNKNOWN, f'{what} names unknown job '
+                                            f'{shown(job)}')
+        if isinstance(revision, bool) or not isinstance(revision, int):
+            return Outcome(Ignored.UNKNOWN, f'{what} has invalid plan revision '
+                                            f'{shown(revision)}')
+        if revision > self.revision:
+            return Outcome(Ignored.UNKNOWN, f'{what} follows plan revision '
+                                            f'{revision}, which was never published '
+                                            f'(current: {self.revision})')
+        if revision < self.jobs[job].since_revision:
+            return Outcome(Ignored.STALE, f"{what} follows plan revision "
+                                          f"{revision}; revision "
+                                          f'{self.jobs[job].since_revision} started '
+                                          f"'{job}' afresh")
+        if self.jobs[job].aborted:
+            return Outcome(Ignored.STALE, f"{what}: job '{job}' was aborted and "
+                                          'waits for a new revision to be redone')
+        if job not in self.plan.jobs:
+            return Outcome(Ignored.STALE, f"{what}: job '{job}' is not in plan "
+                                          f'revision {self.revision}, it was done before')
+        if robot not in self.plan.jobs[job].robots:
+            if revision < self.revision:
+                return Outcome(Ignored.STALE, f"{what} follows plan revision "
+                                              f'{revision}; in revision {self.revision} '
+                                              f"'{robot}' has no part in job '{job}'")
+            return Outcome(Ignored.UNKNOWN, f"{what}: robot '{robot}' has no "
+                                            f"part in job '{job}'")
+        if not _time_ok(time):
+            return Outcome(Ignored.UNKNOWN, f'{what} has invalid time '
+                                            f'{shown(time)}')
+        return None
+
+    def _check_order(self, event_id, kind, robot, job, time) -> Outcome | None:
+        """An operation reported done must have been reported started, and not later: the
+        job's timeline is built from both (a forged event, or the history of an earlier
+        planner arriving after this one's first plan, can break this)."""
+        if kind != EventKind.OPERATION_DONE:
+            return None
+        what = f'event {shown(event_id)}'
+        started = self.jobs[job].started.get(robot)
+        if started is None:
+            return Outcome(Ignored.UNKNOWN, f"{what}: '{robot}' reports "
+                                            f"operation_done for job '{job}' without having "
+                                            'reported started')
+        if time < started:
+            return Outcome(Ignored.UNKNOWN, f"{what}: '{robot}' reports "
+                                            f'operation_done at t={float(time):g} before it '
+                                            f"started at t={float(started):g} (job '{job}')")
+        return None
+
+    def record_robot_state(self, robot: str, mode: str, location: str, destination: str,
+                           busy_until: float, current_job: str = '',
+                           at: float | None = None) -> Outcome:
+        """Use a robot's state report (or heartbeat) observed at schedule time `at`.
+
+        A report that turns a healthy robot failed or offline counts a failure at `at` (by
+        default: the latest time any event reported). A `busy_until` that is not a finite
+        non-negative number reads as NaN (not said). A report naming an unknown robot or
+        place is ignored, and counted once however often it repeats. Never raises.
+        """
+        problem = self._state_problem(robot, mode, location, destination, current_job)
+        if problem is not None:
+            repeated = problem in self._repeated
+            if not repeated:
+                self._repeated.add(problem)
+                self.ignored[Ignored.UNKNOWN] += 1
+            return Outcome(Ignored.UNKNOWN, problem, repeated=repeated)
+        record = self.robots[robot]
+        was_healthy = record.healthy
+        # A robot does not leave its place by restarting its agent, whose new process
+        # reports no location until its first leg: the last one reported still holds.
+        record.mode, record.destination = mode, destination
+        record.location = location or record.location
+        record.busy_until = busy_until if _time_ok(busy_until) else math.nan
+        record.current_job, record.reported = current_job, True
+        self._count_failure(record, was_healthy, at)
+        return Outcome()
+
+    def _state_problem(self, robot, mode, location, destination, current_job) -> str | None:
+        if not isinstance(robot, str) or robot not in self.robots:
+            return f'state of unknown robot {shown(robot)}'
+        fields = {'mode': mode, 'location': location, 'destination': destination,
+                  'current job': current_job}
+        for what, value in fields.items():
+            if not isinstance(value, str):
+                return f"'{robot}' reports a {what} that is not text: {shown(value)}"
+        for what, value in (('location', location), ('destination', destination)):
+            if value and value not in self._locations:
+                return f"'{robot}' reports unknown {what} {shown(value)}"
+        return None
+
+    def mark_offline(self, robot: str, at: float | None = None) -> Outcome:
+        """Its heartbeat was lost (observed at schedule time `at`): treated as failed until it
+        reports again. Counts a failure like `record_robot_state`."""
+        if not isinstance(robot, str) or robot not in self.robots:
+            return Outcome(Ignored.UNKNOWN, f'heartbeat loss of unknown robot {shown(robot)}')
+        record = self.robots[robot]
+        was_healthy = record.healthy
+        record.mode = RobotMode.OFFLINE
+        self._count_failure(record, was_healthy, at)
+        return Outcome()
+
+    def agent_restarted(self, robot: str, at: float | None = None) -> list[str]:
+        """The robot's agent restarted (observed at schedule time `at`): the operations its
+        previous process had not finished are lost, like a failure's. Those jobs are aborted
+        (reports about them wait for a new revision), a hold it kept is lost (a failure is
+        counted), and the aborted jobs are returned. Never raises."""
+        if not isinstance(robot, str) or robot not in self.robots or self.plan is None:
+            return []
+        lost = sorted(name for name in self.running
+                      if robot in self.plan.jobs[name].robots
+                      and robot not in self.jobs[name].operation_done)
+        for name in lost:
+            self.jobs[name] = JobRecord(name, since_revision=self.jobs[name].since_revision,
+                                        aborted=True)
+        record = self.robots[robot]
+        record.failures += 1
+        record.last_failure_at = at if _time_ok(at) else self._latest
+        return lost
+
+    def _count_failure(self, record: RobotRecord, was_healthy: bool, at) -> None:
+        if was_healthy and not record.healthy:
+            record.failures += 1
+            record.last_failure_at = at if _time_ok(at) else self._latest
+
+    # --- what the reports add up to ------------------------------------------------------
+
+    @property
+    def missing_robots(self) -> list[str]:
+        return [name for name, r in self.robots.items() if not r.reported]
+
+    @property
+    def done(self) -> frozenset[str]:
+        return frozenset(name for name, r in self.jobs.items() if r.end is not None)
+
+    @property
+    def running(self) -> frozenset[str]:
+        return frozenset(name for name, r in self.jobs.items()
+                         if r.end is None and r.started)
+
+    def due_start(self, job: str) -> float | None:
+        """When the robots of a job not begun start it, by the reports so far: every robot
+        the plan gives it has arrived and every predecessor has completed. None otherwise.
+        The robots start it on the same reports, so they may have started it before the
+        planner hears of it."""
+        record = self.jobs[job]
+        planned = self.plan.jobs.get(job) if self.plan is not None else None
+        if planned is None or record.begun or record.aborted:
+            return None
+        if any(robot not in record.arrived for robot in planned.robots):
+            return None
+        ends = [self.jobs[before].end for before in self.problem.predecessors(job)]
+        if None in ends:
+            return None
+        return max([record.arrived[robot] for robot in planned.robots] + ends)
+
+    @property
+    def aborted(self) -> frozenset[str]:
+        return frozenset(name for name, r in self.jobs.items() if r.aborted)
+
+    @property
+    def healthy(self) -> frozenset[str]:
+        return frozenset(name for name, r in self.robots.items() if r.healthy)
+
+    @property
+    def complete(self) -> bool:
+        return all(r.end is not None for r in self.jobs.values())
+
+    def _planned_length(self, job: str) -> Fraction:
+        a = self.plan.jobs[job]
+        return a.end - a.start
+
+    def expected_ends(self, now: float) -> dict[str, Fraction]:
+        """Every job's end: actual if done, else projected by shifting the rest of the plan.
+
+        Jobs not started begin as soon as their predecessors complete and their robots are
+        free and have travelled there, but not before `now`; each takes its planned length.
+        """
+        now = Fraction(max(now, 0.0))
+        ends: dict[str, Fraction] = {}
+        robot_free: dict[str, tuple[Fraction, str | None]] = {}
+        for name in sorted(self.plan.jobs, key=lambda j: (self.plan.jobs[j].start,
+                                                          self.plan.jobs[j].end, j)):
+            a, record = self.plan.jobs[name], self.jobs[name]
+            if record.end is not None:
+                end = Fraction(record.end)
+            elif record.start is not None:
+                end = max(Fraction(record.start) + self._planned_length(name), now,
+                          self._reported_end(name))
+            else:
+                start = now
+                for before in self.problem.predecessors(name):
+                    start = max(start, ends.get(before, now))
+                here = self.problem.job(name).location
+                for robot in a.robots:
+                    free, there = robot_free.get(robot, (Fraction(0), None))
+                    travel = Fraction(0) if there is None else self.problem.travel(
+                        robot, there, here)
+                    start = max(start, free + travel)
+                end = start + self._planned_length(name)
+            ends[name] = end
+            for robot in a.robots:
+                robot_free[robot] = (end, self.problem.job(name).location)
+        return ends
+
+    def _reported_end(self, job: str) -> Fraction:
+        """The latest end its working robots expect for their operations (0: none said)."""
+        ends = [Fraction(r.busy_until) for r in self.robots.values()
+                if r.current_job == job and r.mode == RobotMode.WORKING
+                and math.isfinite(r.busy_until) and r.name not in self.jobs[job].operation_done]
+        return max(ends, default=Fraction(0))
+
+    def projected_makespan(self, now: float) -> Fraction:
+        ends = list(self.expected_ends(now).values())
+        ends += [Fraction(r.end) for r in self.jobs.values() if r.end is not None]
+        return max(ends, default=Fraction(0))
+
+    def overruns(self, threshold: float) -> list[str]:
+        """Running jobs whose robots expect to end more than `threshold` after the plan said.
+
+        Only the robots' reported expected ends count: a clock running ahead of delayed
+        messages is no overrun. The plan's end is taken from the job's actual start, so a job
+        that merely started late is not overrunning; a re-plan makes the expected end the
+        planned one.
+        """
+        late = []
+        for name in sorted(self.running):
+            record = self.jobs[name]
+            planned = max(self.plan.jobs[name].end,
+                          Fraction(record.start) + self._planned_length(name))
+            expected = self._reported_end(name)
+            if expected - planned > threshold:
+                late.append(f"job '{name}' is expected to end at {float(expected):.2f}, "
+                            f'{float(expected - planned):.2f} after its plan')
+        return late
+
+    def executed_schedule(self) -> Schedule:
+        """The jobs completed so far, as executed: for `validate` and Gantt charts."""
+        jobs = {name: self.jobs[name].done_as for name in self.done}
+        sequences = {r.name: tuple(sorted((j for j, a in jobs.items() if r.name in a.robots),
+                                          key=lambda j: jobs[j].start))
+                     for r in self.problem.robots}
+        return Schedule(jobs, sequences)
+
+    def execution_state(self, now: float) -> ExecutionState:
+        """The state re-planning starts from (`fjsp_planner.execution.replan`)."""
+        now_f = Fraction(max(now, 0.0))
+        ends = self.expected_ends(now)
+        running = {}
+        for name in self.running:
+            planned = self.plan.jobs[name]
+            running[name] = JobAssignment(name, planned.plan, Fraction(self.jobs[name].start),
+                                          ends[name], dict(planned.robots))
+        robots = {}
+        for name, r in self.robots.items():
+            robot = self.problem.robot(name)
+            on = [j for j, a in running.items() if name in a.robots]
+            if on:
+                location, free_at = self.problem.job(on[0]).location, running[on[0]].end
+            elif r.mode == RobotMode.TRAVELLING and r.destination:
+                arrival = r.busy_until if math.isfinite(r.busy_until) else now
+                location, free_at = r.destination, max(Fraction(arrival), now_f)
+            else:
+                # An agent reports no location until its first leg places it: until then
+                # it is where its last job left it (an agent restarted under a planner
+                # restarted too), else where the mission starts it.
+                location, free_at = r.location or self._last_place(name), now_f
+            # Nor is it free before its release time, however idle it looks.
+            free_at = max(free_at, Fraction(robot.release_time))
+            failed_at = None if r.last_failure_at is None else Fraction(r.last_failure_at)
+            robots[name] = RobotState(name, r.healthy, location, free_at, failed_at)
+        done_as = {name: self.jobs[name].done_as for name in self.done
+                   if self.jobs[name].done_as is not None}
+        return ExecutionState(now_f, self.done, running, robots, done_as)
+
+    def _last_place(self, robot: str) -> str | None:
+        """Where the last job the robot completed is, else where the mission starts it."""
+        done = [a for name in self.done if (a := self.jobs[name].done_as) is not None
+                and robot in a.robots]
+        if not done:
+            return self.problem.robot(robot).start_location
+        return self.problem.job(max(done, key=lambda a: a.end).job).location
+
+    def violations(self) -> list[str]:
+        """Every way the executed timeline (the jobs done so far, as they ran) breaks the
+        mission's problem: precedence, holding arcs, staffing (plans, distinct able robots),
+        robots on two jobs at once, travel and release times. Empty: it is valid.
+
+        A mission run across several plan revisions is checked against the problem as
+        posed, with two allowances for what execution legitimately changes: operations last
+        as long as the agents reported (delay faults lengthen or shorten them), and travel
+        between two consecutive jobs of a robot is held to the shortest route between their
+        locations, since the robot may have passed through the location of a job that was
+        aborted or left out of a new revision on its way.
+        """
+        executed = self.executed_schedule()
+        done = set(executed.jobs)
+        messages = []
+        for before, after in self.problem.precedence:
+            if after in done and before not in done:
+                messages.append(f"job '{after}' is done but '{before}', which must complete "
+                                'before it, is not')
+        for source, target, _ in self.problem.holding:
+            if target in done and source not in done:
+                messages.append(f"job '{target}' is done but '{source}', which holds into "
+                                'it, is not')
+        return messages + validate(self._as_executed(executed), executed)
+
+    def _as_executed(self, executed: Schedule) -> Problem:
+        """The problem restricted to the executed jobs, operations free of duration and
+        distances relaxed to shortest routes where the direct one does not fit."""
+        p = self.problem
+        done = set(executed.jobs)
+        locomote = p.locomote
+        return dataclasses.replace(
+            p, jobs=tuple(j for j in p.jobs if j.name in done),
+            precedence=tuple((a, b) for a, b in p.precedence if a in done and b in done),
+            holding=tuple((a, b, q) for a, b, q in p.holding if a in done and b in done),
+            robot_types={name: {q: (t if q == locomote else Fraction(0))
+                                for q, t in times.items()}
+                         for name, times in p.robot_types.items()},
+            time_overrides=dict.fromkeys(p.time_overrides, Fraction(0)),
+            distances=relaxed_distances(p, executed), fixed={}, panels=(),
+            name=f'{p.name} as executed')
+
+
+def relaxed_distances(problem: Problem, executed: Schedule) -> dict:
+    """The problem's distances, with the shortest route in place of the direct one between
+    two consecutive jobs of a robot that it went between faster than directly: on its way it
+    may have passed through the location of a job that was aborted or left out of a new
+    revision (a robot withdrawn from a job waits at its location)."""
+    legs = set()
+    for robot in problem.robots:
+        jobs = [executed.jobs[j] for j in executed.sequences.get(robot.name, ())]
+        where = robot.start_location
+        free = robot.release_time
+        for a in jobs:
+            here = problem.job(a.job).location
+            if where is not None and a.start < free + problem.travel(robot.name, where, here):
+                legs.add((where, here))
+            where, free = here, a.end
+    distances = dict(problem.distances)
+    nearest = {}
+    for a, b in legs:
+        if a not in nearest:
+            nearest[a] = _shortest_distances(problem, a)
+        distances[a, b] = distances[b, a] = nearest[a][b]
+    return distances
+
+
+def _shortest_distances(problem: Problem, source: str) -> dict[str, Fraction]:
+    """Dijkstra over the complete graph of locations (distances need not be metric)."""
+    places = problem.locations()
+    best = {place: problem.distance(source, place) for place in places}
+    todo = set(places) - {source}
+    while todo:
+        nearest = min(todo, key=best.__getitem__)
+        todo.remove(nearest)
+        for place in todo:
+            via = best[nearest] + problem.distance(nearest, place)
+            if via < best[place]:
+                best[place] = via
+    return best
+
+
+def _time_ok(value) -> bool:
+    """A reported time: a number within [0, MAX_REPORTED_TIME] (not NaN, not infinite)."""
+    return (isinstance(value, numbers.Real) and not isinstance(value, bool)
+            and 0 <= value <= MAX_REPORTED_TIME)

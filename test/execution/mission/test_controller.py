@@ -1,0 +1,918 @@
+"""The mission controller's decisions, driven by hand-made reports and a fake clock (no ROS).
+
+The paper's instance: its optimum (32) is found in well under a second, so every solve the
+controller asks for is run here for real, through the same functions the node calls.
+"""
+
+from dataclasses import replace
+from fractions import Fraction
+
+import pytest
+
+from fjsp_common.vocabulary import EventKind, MissionEventKind, MissionState, RobotMode
+from fjsp_planner.execution.mission.controller import (
+    DUE_GRACE,
+    IMPROVE_REACH,
+    PLAN_RESEND_AFTER,
+    EventReport,
+    JobDone,
+    MissionController,
+    Note,
+    PublishPlan,
+    ResendPlan,
+    RobotReport,
+    Settings,
+    Solve,
+)
+from fjsp_planner.execution.replan import Improvement, Replan, improve, repair
+from fjsp_planner.model.scenario import load_scenario
+from fjsp_planner.model.schedule import Schedule
+from fjsp_planner.solving.solve import solve
+
+from repo_paths import PAPER
+
+ROBOTS = ('Assembler', 'LSMS', 'MARC1', 'MARC2')
+SETTINGS = Settings(time_limit=5.0, replan_time_limit=2.0, heartbeat_timeout=1.0,
+                    robot_wait_timeout=3.0, start_delay=0.0, time_scale=1.0)
+
+
+@pytest.fixture(scope='module')
+def problem():
+    return load_scenario(PAPER)
+
+
+class Fleet:
+    """A controller, a clock in wall seconds (= schedule units here) and the effects so far."""
+
+    def __init__(self, problem, settings=SETTINGS):
+        self.problem = problem
+        self.controller = MissionController(settings)
+        self.wall = 1000.0
+        self.effects = []
+        self.failures = dict.fromkeys(ROBOTS, 0)
+        self.incarnations = dict.fromkeys(ROBOTS, 1)
+        self.modes = dict.fromkeys(ROBOTS, RobotMode.IDLE)
+        self.refusals = dict.fromkeys(ROBOTS, '')
+        self.following = {}
+        """Fields every report of the robots repeats, e.g. the mission they follow."""
+        self.deaf = set()
+        """Robots whose agents take no plan any more: they report the last one they took."""
+        self.taken = {}
+        """Robot -> (mission, revision) of the latest plan its agent took."""
+        self.events = 0
+
+    def take(self, effects):
+        self.effects += effects
+        return effects
+
+    def start(self, mission='m1'):
+        return self.take(self.controller.start(self.problem, mission, self.wall))
+
+    def report(self, robot, mode=None, **fields):
+        if mode is not None:
+            self.modes[robot] = mode
+        mission = self.controller.mission
+        if robot not in self.deaf and mission is not None and mission.tracker.revision:
+            self.taken[robot] = (mission.id, mission.tracker.revision)
+        mission_id, revision = self.taken.get(robot, ('', 0))
+        report = RobotReport(robot, self.modes[robot], incarnation=self.incarnations[robot],
+                             failures=self.failures[robot], refusal=self.refusals[robot],
+                             **{'mission_id': mission_id, 'revision': revision,
+                                **self.following, **fields})
+        return self.take(self.controller.robot_state(report, self.wall))
+
+    def heartbeat(self, robots=ROBOTS):
+        for robot in robots:
+            self.report(robot)
+
+    def tick(self, advance=0.1, robots=ROBOTS):
+        """Advance the clock in heartbeat-sized steps, robots in `robots` reporting."""
+        effects = []
+        steps = max(1, round(advance / 0.1))
+        for _ in range(steps):
+            self.wall += advance / steps
+            self.heartbeat(robots)
+            effects += self.take(self.controller.tick(self.wall))
+        return effects
+
+    def tick_until_solve(self, ticks=20):
+        """Tick until the controller asks for one solve (at most `ticks` times); that request."""
+        for _ in range(ticks):
+            requests = kinds(self.tick(), Solve)
+            if requests:
+                (request,) = requests
+                return request
+        raise AssertionError(f'no solve requested within {ticks} ticks')
+
+    def run_solves(self, effects=None, improve_too=False):
+        """Carry out the pending solves as the node would (a search for a better plan only
+        with `improve_too`); the effects of their outcomes."""
+        out = []
+        for effect in list(self.effects if effects is None else effects):
+            if not isinstance(effect, Solve) or (effect.kind == 'improve' and not improve_too):
+                continue
+            if effect.kind == 'plan':
+                outcome = solve(effect.problem, time_limit=effect.time_limit)
+            elif effect.kind == 'repair':
+                outcome = repair(effect.problem, effect.previous, effect.state,
+                                 time_limit=effect.time_limit)
+            else:
+                outcome = improve(effect.published, time_limit=effect.time_limit,
+                                  frozen_until=effect.frozen_until, started=effect.started)
+            out += self.take(self.controller.solved(effect.token, outcome, self.wall))
+        return out
+
+    def event(self, kind, robot, job, time, mission='m1', revision=None):
+        self.events += 1
+        revision = self.controller.mission.tracker.revision if revision is None else revision
+        effects, why = self.controller.task_event(
+            EventReport(f'{robot}/{self.events}', mission, kind, robot, job, revision, time),
+            self.wall)
+        self.take(effects)
+        return effects, why
+
+    def execute(self, until=None, without=''):
+        """Report the current plan's jobs as executed to plan (those starting before
+        `until`, and not involving robot `without`), in start order."""
+        plan = self.controller.mission.schedule
+        tracker = self.controller.mission.tracker
+        for name, a in sorted(plan.jobs.items(), key=lambda kv: kv[1].start):
+            if until is not None and a.start >= until:
+                break
+            if tracker.jobs[name].end is not None or without in a.robots:
+                continue
+            for robot in a.robots:
+                if robot not in tracker.jobs[name].started:
+                    self.event(EventKind.STARTED, robot, name, float(a.start))
+            for robot, q in a.robots.items():
+                end = a.start + self.problem.duration(robot, q)
+                if until is None or end <= until:
+                    self.event(EventKind.OPERATION_DONE, robot, name, float(end))
+
+    def state(self):
+        return self.controller.mission.state
+
+    def status(self):
+        return self.controller.status(self.wall)
+
+
+def kinds(effects, kind):
+    return [e for e in effects if isinstance(e, kind)]
+
+
+def notes(effects, kind):
+    return [e for e in effects if isinstance(e, Note) and e.kind == kind]
+
+
+def executing(problem, settings=SETTINGS) -> Fleet:
+    """A fleet whose four robots reported, with revision 1 published."""
+    fleet = Fleet(problem, settings)
+    fleet.start()
+    fleet.heartbeat()
+    fleet.tick()
+    fleet.run_solves()
+    assert fleet.state() == MissionState.EXECUTING
+    return fleet
+
+
+def test_first_plan_waits_for_every_robot_then_solves_the_scenario(problem):
+    fleet = Fleet(problem)
+    effects = fleet.start()
+    assert notes(effects, MissionEventKind.MISSION_STARTED)
+    assert fleet.state() == MissionState.WAITING_FOR_ROBOTS
+    assert fleet.status().blocked == ("waiting for robot 'Assembler' to report",
+                                      "waiting for robot 'LSMS' to report",
+                                      "waiting for robot 'MARC1' to report",
+                                      "waiting for robot 'MARC2' to report")
+    fleet.heartbeat(ROBOTS[:3])
+    assert not kinds(fleet.tick(robots=ROBOTS[:3]), Solve)
+    fleet.heartbeat()
+    (request,) = kinds(fleet.tick(), Solve)
+    assert request.kind == 'plan' and request.problem is problem  # nothing moved: as given
+    assert fleet.state() == MissionState.PLANNING
+    (published,) = kinds(fleet.run_solves(), PublishPlan)
+    assert published.revision == 1 and published.result.makespan == 32
+    assert fleet.state() == MissionState.EXECUTING
+
+
+def test_a_robot_that_never_reports_is_planned_without_and_named(problem):
+    fleet = Fleet(problem)
+    fleet.start()
+    fleet.tick(advance=3.5, robots=ROBOTS[:3])
+    (request,) = kinds(fleet.effects, Solve)
+    assert {r.name for r in request.problem.robots} == {'Assembler', 'LSMS', 'MARC1'}
+    fleet.run_solves()
+    assert fleet.state() == MissionState.EXECUTING
+    assert any("robot 'MARC2' has not reported" in w for w in fleet.status().warnings)
+    fleet.report('MARC2')
+    replans = kinds(fleet.tick(), Solve)
+    assert replans and "robot 'MARC2' available" in replans[0].reasons
+
+
+def test_a_changed_robot_wait_applies_to_the_mission_waiting(problem):
+    """`robot_wait_timeout` may be set at run time (`ros2 param set`) as
+    `plan_uptake_timeout` and `heartbeat_timeout` may: a user lengthening it while a mission
+    waits for a robot expects that mission to wait longer, not only the next one."""
+    fleet = Fleet(problem)
+    fleet.start()
+    fleet.controller.settings = replace(SETTINGS, robot_wait_timeout=10.0)
+    fleet.tick(advance=5.0, robots=ROBOTS[:3])
+    assert not kinds(fleet.effects, Solve)
+    fleet.tick(advance=5.5, robots=ROBOTS[:3])
+    (request,) = kinds(fleet.effects, Solve)
+    assert {r.name for r in request.problem.robots} == {'Assembler', 'LSMS', 'MARC1'}
+
+
+def test_failure_replans_without_the_robot(problem):
+    fleet = executing(problem)
+    fleet.wall += 5
+    fleet.execute(until=5)
+    fleet.failures['MARC1'] += 1
+    effects = fleet.report('MARC1', RobotMode.FAILED)
+    assert notes(effects, MissionEventKind.ROBOT_FAILED)
+    (request,) = kinds(fleet.tick(), Solve)
+    assert request.kind == 'repair' and "robot 'MARC1' failed" in request.reasons
+    assert not request.state.robots['MARC1'].healthy
+    (published,) = kinds(fleet.run_solves(), PublishPlan)
+    assert published.revision == 2 and 'MARC1' not in published.result.schedule.sequences
+
+
+def test_failure_and_recovery_between_two_ticks_still_replans(problem):
+    """The recovered agent dropped its tasks: it must be planned in again, though it looks
+    as healthy as before."""
+    fleet = executing(problem)
+    fleet.failures['MARC1'] += 1
+    fleet.report('MARC1', RobotMode.FAILED)
+    fleet.report('MARC1', RobotMode.IDLE)
+    (request,) = kinds(fleet.tick(), Solve)
+    assert "robot 'MARC1' failed and recovered" in request.reasons
+
+
+def test_a_restarted_agent_is_replanned(problem):
+    fleet = executing(problem)
+    fleet.incarnations['LSMS'] = 2
+    (request,) = kinds(fleet.tick(), Solve)
+    assert "robot 'LSMS' restarted: its agent lost its tasks" in request.reasons
+
+
+def test_a_refusing_agent_is_left_out_and_named(problem):
+    fleet = executing(problem)
+    fleet.refusals['MARC2'] = "plan revision 1 makes 'MARC2' a 'MARC' but this agent plays a " \
+                              "'Gantry'; refusing the plan"
+    effects = fleet.report('MARC2')
+    (warning,) = notes(effects, MissionEventKind.WARNING)
+    assert 'MARC2' in warning.reasons[0] and 'refuses its plan' in warning.reasons[0]
+    (request,) = kinds(fleet.tick(), Solve)
+    assert not request.state.robots['MARC2'].healthy
+    fleet.run_solves()
+    assert fleet.state() == MissionState.EXECUTING
+    assert any('refuses its plan' in w for w in fleet.status().warnings)
+
+
+def test_a_robot_that_does_not_take_the_plan_gets_it_again_then_is_planned_without(problem):
+    """An agent that reports but stays on an older revision (its subscription never matched
+    the plan's writer) would leave its jobs undone while it looks healthy."""
+    fleet = Fleet(problem, replace(SETTINGS, plan_uptake_timeout=5.0))
+    fleet.deaf.add('MARC2')
+    fleet.start()
+    fleet.tick()
+    fleet.run_solves()
+    assert fleet.state() == MissionState.EXECUTING
+    assert not kinds(fleet.tick(advance=PLAN_RESEND_AFTER - 0.3), ResendPlan)
+    effects = fleet.tick(advance=0.5)
+    assert kinds(effects, ResendPlan) == [ResendPlan(1)]
+    (warning,) = notes(effects, MissionEventKind.WARNING)
+    assert warning.robot == 'MARC2' and 'has not taken plan revision 1' in warning.reasons[0]
+    assert not kinds(fleet.tick(advance=1.0), ResendPlan)  # once per revision
+    assert not kinds(fleet.effects, Solve)[1:]
+    (request,) = kinds(fleet.tick(advance=5.0 - PLAN_RESEND_AFTER - 1.0), Solve)
+    assert "robot 'MARC2' has not taken plan revision 1 within 5 s" in request.reasons
+    assert not request.state.robots['MARC2'].healthy
+    (published,) = kinds(fleet.run_solves(), PublishPlan)
+    assert 'MARC2' not in published.result.schedule.sequences
+    # Left out until it takes a revision, however long that takes: no re-plan meanwhile.
+    assert not kinds(fleet.tick(advance=12.0), Solve)
+    assert any("'MARC2' has not taken plan revision 1" in w for w in fleet.status().warnings)
+    fleet.deaf.discard('MARC2')
+    (request,) = kinds(fleet.tick(), Solve)
+    assert "robot 'MARC2' available" in request.reasons
+
+
+def test_a_robot_back_from_an_offline_spell_has_time_to_take_the_plan(problem):
+    """Offline, it could not take the revision published meanwhile: its lag counts from
+    when it is heard again."""
+    fleet = executing(problem)
+    fleet.deaf.add('MARC2')
+    fleet.tick(advance=1.5, robots=ROBOTS[:3])
+    assert "robot 'MARC2' offline (heartbeat lost)" in kinds(fleet.effects, Solve)[-1].reasons
+    (published,) = kinds(fleet.run_solves(), PublishPlan)
+    fleet.tick(advance=PLAN_RESEND_AFTER + 1.0, robots=ROBOTS[:3])
+    effects = fleet.tick(advance=PLAN_RESEND_AFTER - 0.5)  # back, on revision 1 at first
+    assert not kinds(effects, ResendPlan) and not notes(effects, MissionEventKind.WARNING)
+    fleet.deaf.discard('MARC2')
+    fleet.tick(advance=2.0)
+    assert not kinds(fleet.effects, ResendPlan)
+
+
+def test_robots_that_take_every_plan_are_never_told_again(problem):
+    fleet = executing(problem, replace(SETTINGS, plan_uptake_timeout=3.0))
+    fleet.tick(advance=20.0)
+    assert not kinds(fleet.effects, ResendPlan)
+    assert not notes(fleet.effects, MissionEventKind.WARNING)
+    assert len(kinds(fleet.effects, Solve)) == 1
+
+
+def test_when_every_robot_refuses_the_mission_is_blocked_naming_them(problem):
+    fleet = Fleet(problem)
+    fleet.start()
+    for robot in ROBOTS:
+        fleet.refusals[robot] = f"plan revision 1 makes '{robot}' a 'X' but this agent plays " \
+                                "a 'Gantry'"
+    fleet.tick(advance=0.2)
+    assert fleet.state() == MissionState.BLOCKED
+    blocked = '\n'.join(fleet.status().blocked)
+    assert "job 'M1' cannot be staffed" in blocked
+    assert "robot 'MARC1' refuses its plan" in blocked
+
+
+def test_unknown_agent_is_a_warning(problem):
+    fleet = executing(problem)
+    effects = fleet.take(fleet.controller.robot_state(RobotReport('R2D2', RobotMode.IDLE),
+                                                      fleet.wall))
+    (warning,) = notes(effects, MissionEventKind.WARNING)
+    assert "'R2D2'" in warning.reasons[0]
+    assert any("agent of robot 'R2D2' is running" in w for w in fleet.status().warnings)
+    # Its heartbeats are one warning, not one per heartbeat.
+    assert not fleet.controller.robot_state(RobotReport('R2D2', RobotMode.IDLE), fleet.wall)
+
+
+def test_heartbeat_loss_then_back_after_a_full_timeout(problem):
+    fleet = executing(problem)
+    effects = fleet.tick(advance=1.5, robots=('Assembler', 'LSMS', 'MARC1'))
+    assert notes(effects, MissionEventKind.ROBOT_OFFLINE)[0].robot == 'MARC2'
+    (request,) = kinds(effects, Solve)
+    assert "robot 'MARC2' offline (heartbeat lost)" in request.reasons
+    fleet.run_solves()
+    # One heartbeat is not enough to count again: it must keep reporting for a timeout.
+    assert not kinds(fleet.tick(), Solve)
+    assert not notes(fleet.tick(advance=0.5), MissionEventKind.ROBOT_BACK)
+    effects = fleet.tick(advance=0.7)
+    assert notes(effects, MissionEventKind.ROBOT_BACK)
+    assert "robot 'MARC2' available" in kinds(effects, Solve)[0].reasons
+
+
+def test_a_starved_executor_does_not_make_robots_offline(problem):
+    fleet = executing(problem)
+    fleet.wall += 2.0  # nothing processed for 2 s, then a tick comes first
+    assert not notes(fleet.take(fleet.controller.tick(fleet.wall)),
+                     MissionEventKind.ROBOT_OFFLINE)
+
+
+def test_executed_mission_completes(problem):
+    fleet = executing(problem)
+    fleet.execute()
+    assert len(kinds(fleet.effects, JobDone)) == 12
+    assert fleet.state() == MissionState.COMPLETE
+    (complete,) = notes(fleet.effects, MissionEventKind.MISSION_COMPLETE)
+    assert 'executed makespan 32.00' in complete.reasons[0]
+
+
+def test_an_invalid_executed_timeline_fails_the_mission(problem):
+    """Jobs reported done in an order that breaks precedence: not a success."""
+    fleet = executing(problem)
+    plan = fleet.controller.mission.schedule
+    for name, a in plan.jobs.items():
+        for robot in a.robots:
+            fleet.event(EventKind.STARTED, robot, name, 0.0)
+            fleet.event(EventKind.OPERATION_DONE, robot, name, 1.0)
+    assert fleet.state() == MissionState.FAILED
+    assert any('executed timeline' in r for r in fleet.status().blocked)
+
+
+def test_events_of_another_mission_are_counted_once_logged(problem):
+    fleet = executing(problem)
+    _, why = fleet.event(EventKind.STARTED, 'MARC1', 'M1', 0.0, mission='old')
+    assert "mission 'old'" in why
+    _, again = fleet.event(EventKind.STARTED, 'MARC1', 'M2', 0.0, mission='old')
+    assert again == ''
+    assert fleet.status().ignored['stale'] == 2
+
+
+def test_a_replan_outdated_by_the_fleet_is_discarded(problem):
+    fleet = executing(problem)
+    fleet.failures['MARC1'] += 1
+    fleet.report('MARC1', RobotMode.FAILED)
+    (request,) = kinds(fleet.tick(), Solve)
+    fleet.report('MARC1', RobotMode.IDLE)  # recovered while the solve ran
+    effects = fleet.run_solves([request])
+    assert not kinds(effects, PublishPlan)
+    assert fleet.state() == MissionState.EXECUTING
+    assert kinds(fleet.tick(), Solve)  # and planned again
+
+
+def test_jobs_done_while_replanning_are_not_redone(problem):
+    fleet = executing(problem)
+    fleet.wall += 2
+    fleet.execute(until=2)
+    # A robot that some job of the next 10 units can do without.
+    window = [a for a in fleet.controller.mission.schedule.jobs.values()
+              if 2 <= a.start and a.end <= 12]
+    out = next(r for r in ROBOTS if any(r not in a.robots for a in window))
+    fleet.failures[out] += 1
+    fleet.report(out, RobotMode.FAILED)
+    (request,) = kinds(fleet.tick(), Solve)
+    # Before the new plan arrives, the other robots finish more jobs of the old one.
+    fleet.execute(until=12, without=out)
+    done = set(fleet.controller.mission.tracker.done)
+    assert done - set(request.state.done)
+    effects = fleet.run_solves([request])
+    published = kinds(effects, PublishPlan)
+    if published:
+        # It let what progressed go on as it is: nothing done is started afresh.
+        (plan,) = published
+        assert set(done) - set(request.state.done) <= plan.continued
+        assert not (set(plan.result.schedule.jobs) - plan.continued) & done
+        assert fleet.controller.mission.tracker.done >= done
+    else:
+        (warning,) = notes(effects, MissionEventKind.WARNING)
+        assert 'progressed while it was solved' in warning.reasons[0]
+        (again,) = kinds(fleet.tick(), Solve)
+        assert set(again.state.done) >= done
+        assert f"robot '{out}' failed" in again.reasons
+
+
+def at_the_first_crew_job(problem):
+    """A mission executed to plan until its first job of several robots, which have all
+    reported arriving there; (the fleet, that job, its assignment)."""
+    fleet = executing(problem)
+    first = fleet.controller.mission.schedule
+    job, assignment = min(((name, a) for name, a in first.jobs.items() if len(a.robots) > 1),
+                          key=lambda kv: kv[1].start)
+    fleet.wall += float(assignment.start)
+    fleet.execute(until=assignment.start)
+    for robot in assignment.robots:
+        fleet.event(EventKind.ARRIVED, robot, job, float(assignment.start))
+    return fleet, job, assignment
+
+
+def kept_as_planned(fleet, request):
+    """The outcome of the re-plan `request` asks for, its schedule made the current plan
+    less the jobs done, plus the jobs the re-plan adds: a plan that leaves every job as it
+    was, whatever the heuristics would have chosen."""
+    current = fleet.controller.mission.schedule
+    done = fleet.controller.mission.tracker.done
+    outcome = repair(request.problem, request.previous, request.state)
+    jobs = {name: a for name, a in current.jobs.items() if name not in done}
+    sequences = {robot: tuple(j for j in sequence if j in jobs)
+                 for robot, sequence in current.sequences.items()}
+    for name, a in outcome.result.schedule.jobs.items():
+        if name not in current.jobs:
+            jobs[name] = a
+            for robot in a.robots:
+                sequences[robot] += (name,)
+    return replace(outcome, result=replace(outcome.result, schedule=Schedule(jobs, sequences)))
+
+
+def test_a_job_its_robots_reached_goes_on_when_the_new_plan_keeps_it(problem):
+    """A re-plan published while the robots of a job start it, their reports still on the
+    way: the job goes on under the new revision, so those reports count, rather than being
+    voided and the job done twice."""
+    from fjsp_planner.model.extension import extend
+
+    fleet, job, assignment = at_the_first_crew_job(problem)
+    tracker = fleet.controller.mission.tracker
+    extended, added = extend(problem, 'jobs: [{name: Inspect, location: Ad, plans: '
+                             '[[locomote]]}]\nprecedence: [[Ad, Inspect]]\n',
+                             tracker.done | tracker.running)
+    (request,) = kinds(fleet.controller.add_jobs(extended, added, fleet.wall), Solve)
+    outcome = kept_as_planned(fleet, request)
+    (published,) = kinds(fleet.controller.solved(request.token, outcome, fleet.wall),
+                         PublishPlan)
+    assert 'Inspect' in published.result.schedule.jobs
+    assert job in published.continued
+    assert published.revision == 2
+    # An agent that missed revision 1 still knows which reports about each job count.
+    assert published.restarted_in[job] == 1
+    assert published.restarted_in['Inspect'] == 2
+    assert all(published.restarted_in[name] == 2 for name in published.result.schedule.jobs
+               if name not in published.continued)
+    for robot in assignment.robots:
+        _, ignored = fleet.event(EventKind.STARTED, robot, job, float(assignment.start),
+                                 revision=1)
+        assert ignored == ''
+    assert set(tracker.jobs[job].started) == set(assignment.robots)
+    fleet.execute()
+    assert fleet.state() == MissionState.COMPLETE
+
+
+def test_a_new_plan_that_moves_a_job_fallen_due_is_discarded(problem):
+    """The robots of a job all arrived and its predecessors completed: they start it on
+    those reports, so the planner that has not heard yet they did must not give it to others
+    (they would do it twice); it plans again, and goes on once the starts are heard."""
+    fleet, job, assignment = at_the_first_crew_job(problem)
+    tracker = fleet.controller.mission.tracker
+    assert tracker.due_start(job) == float(assignment.start)
+    request, outcome = moved_by_a_replan(fleet, job, assignment)
+    effects = fleet.take(fleet.controller.solved(request.token, outcome, fleet.wall))
+    assert not kinds(effects, PublishPlan)
+    (warning,) = notes(effects, MissionEventKind.WARNING)
+    assert f"job '{job}'" in warning.reasons[0]
+    for robot in assignment.robots:
+        fleet.event(EventKind.STARTED, robot, job, float(assignment.start))
+    (again,) = kinds(fleet.tick(), Solve)
+    assert job in again.state.running
+
+
+def test_a_job_fallen_due_long_ago_does_not_hold_a_new_plan_back(problem):
+    """No start heard DUE_GRACE after the job fell due: a report is missing, not on its
+    way, and the new plan is published as it is."""
+    fleet, job, assignment = at_the_first_crew_job(problem)
+    fleet.wall += 2 * DUE_GRACE / SETTINGS.time_scale
+    request, outcome = moved_by_a_replan(fleet, job, assignment)
+    effects = fleet.take(fleet.controller.solved(request.token, outcome, fleet.wall))
+    (published,) = kinds(effects, PublishPlan)
+    assert job not in published.continued
+
+
+def moved_by_a_replan(fleet, job, assignment):
+    """A robot outside the job's crew fails; the re-plan requested, and its outcome made to
+    give the job to other robots."""
+    out = next(r for r in ROBOTS if r not in assignment.robots)
+    fleet.failures[out] += 1
+    fleet.report(out, RobotMode.FAILED)
+    (request,) = kinds(fleet.tick(), Solve)
+    outcome = repair(request.problem, request.previous, request.state)
+    schedule = outcome.result.schedule
+    others = dict(zip((r for r in ROBOTS if r not in assignment.robots and r != out),
+                      assignment.robots.values(), strict=False))
+    moved = replace(schedule, jobs={**schedule.jobs,
+                                    job: replace(schedule.jobs[job], robots=others)})
+    return request, replace(outcome, result=replace(outcome.result, schedule=moved))
+
+
+def test_a_job_whose_robot_first_redoes_a_job_begun_starts_afresh(problem):
+    """A robot at a job is sent first to redo a job begun elsewhere (its robot went offline
+    on it): the job it waits at is no longer its next, so its arrival there must not let the
+    others start it without it."""
+    fleet = executing(problem)
+    first = fleet.controller.mission.schedule
+    job, assignment = min(((name, a) for name, a in first.jobs.items() if len(a.robots) > 1),
+                          key=lambda kv: kv[1].start)
+    begun, running = max(((name, a) for name, a in first.jobs.items()
+                          if name in problem.predecessors(job)), key=lambda kv: kv[1].start)
+    (lost,) = running.robots
+    assert lost not in assignment.robots
+    fleet.wall += float(running.start)
+    fleet.execute(until=running.start + Fraction(1, 2))
+    for robot in assignment.robots:
+        fleet.event(EventKind.ARRIVED, robot, job, float(running.start))
+    effects = fleet.tick(advance=1.5, robots=[r for r in ROBOTS if r != lost])
+    (request,) = kinds(effects, Solve)
+    outcome = kept_as_planned(fleet, request)
+    # The plan as it was, but for the begun job, redone first by a robot of the job.
+    helper = next(iter(assignment.robots))
+    kept = outcome.result.schedule
+    sequences = {robot: tuple(j for j in sequence if j != begun)
+                 for robot, sequence in kept.sequences.items()}
+    sequences[helper] = (begun, *sequences[helper])
+    redone = Schedule({**kept.jobs, begun: replace(
+        running, robots={helper: next(iter(running.robots.values()))})}, sequences)
+    outcome = replace(outcome, result=replace(outcome.result, schedule=redone))
+    (published,) = kinds(fleet.controller.solved(request.token, outcome, fleet.wall),
+                         PublishPlan)
+    assert begun not in published.continued
+    assert job not in published.continued
+
+
+def test_a_job_a_restarted_robot_had_reached_starts_afresh(problem):
+    """The agent of a robot waiting at a job restarted: its new process does not know it
+    waits there, so its arrival must not let the others start the job without it."""
+    fleet, job, assignment = at_the_first_crew_job(problem)
+    restarted = next(iter(assignment.robots))
+    fleet.incarnations[restarted] += 1
+    request = fleet.tick_until_solve()
+    assert f"robot '{restarted}' restarted: its agent lost its tasks" in request.reasons
+    outcome = kept_as_planned(fleet, request)
+    (published,) = kinds(fleet.controller.solved(request.token, outcome, fleet.wall),
+                         PublishPlan)
+    assert job not in published.continued
+    assert fleet.controller.mission.tracker.jobs[job].arrived == {}
+
+
+def test_a_job_the_new_plan_gives_other_robots_starts_afresh(problem):
+    """Going on is for jobs the new plan leaves as they were: one that a failed robot was
+    waiting at is started afresh, its arrivals void."""
+    fleet, job, assignment = at_the_first_crew_job(problem)
+    out = next(r for r in assignment.robots if r != 'Assembler')
+    fleet.failures[out] += 1
+    fleet.report(out, RobotMode.FAILED)
+    (request,) = kinds(fleet.tick(), Solve)
+    (published,) = kinds(fleet.run_solves([request]), PublishPlan)
+    assert out not in published.result.schedule.jobs[job].robots
+    assert job not in published.continued
+    assert fleet.controller.mission.tracker.jobs[job].arrived == {}
+
+
+def test_stale_solve_outcomes_are_dropped(problem):
+    fleet = executing(problem)
+    assert fleet.controller.solved(999, None, fleet.wall) == []
+
+
+def test_cancel_publishes_a_cancelling_revision_and_frees_the_fleet(problem):
+    fleet = executing(problem)
+    with pytest.raises(ValueError, match='one mission per fleet'):
+        fleet.controller.start(problem, 'm2', fleet.wall)
+    effects = fleet.take(fleet.controller.cancel('operator cancelled', fleet.wall))
+    (cancelling,) = kinds(effects, PublishPlan)
+    assert cancelling.cancelled and cancelling.revision == 2
+    assert fleet.state() == MissionState.CANCELLED
+    assert fleet.status().blocked == ('operator cancelled',)
+    with pytest.raises(ValueError, match='no mission is running'):
+        fleet.controller.cancel('again', fleet.wall)
+    fleet.controller.start(problem, 'm2', fleet.wall)
+    assert fleet.controller.mission.id == 'm2'
+
+
+def test_next_mission_starts_where_the_robots_are(problem):
+    fleet = executing(problem)
+    fleet.execute()
+    for robot in ROBOTS:
+        fleet.report(robot, location='Ad')
+    (request,) = kinds(fleet.controller.start(problem, 'm2', fleet.wall), Solve)
+    assert {r.start_location for r in request.problem.robots} == {'Ad'}
+
+
+def test_blocked_for_longer_than_the_timeout_fails(problem):
+    fleet = executing(problem, replace(SETTINGS, blocked_timeout=2.0))
+    for robot in ('MARC1', 'MARC2'):
+        fleet.failures[robot] += 1
+        fleet.report(robot, RobotMode.FAILED)
+    fleet.tick()
+    fleet.run_solves()
+    assert fleet.state() == MissionState.BLOCKED
+    fleet.tick(advance=2.5)
+    assert fleet.state() == MissionState.FAILED
+    assert 'blocked for 2 s' in fleet.status().blocked[0]
+
+
+def test_jobs_added_mid_mission_are_replanned_in(problem):
+    from fjsp_planner.model.extension import extend
+
+    fleet = executing(problem)
+    fleet.wall += 5
+    fleet.execute(until=5)
+    tracker = fleet.controller.mission.tracker
+    extended, added = extend(problem, 'jobs: [{name: Inspect, location: Ad, plans: '
+                             '[[locomote]]}]\nprecedence: [[Ad, Inspect]]\n',
+                             tracker.done | tracker.running)
+    effects = fleet.take(fleet.controller.add_jobs(extended, added, fleet.wall))
+    assert notes(effects, MissionEventKind.JOBS_ADDED)[0].job == 'Inspect'
+    (request,) = kinds(effects, Solve)
+    assert 'jobs added: Inspect' in request.reasons
+    (published,) = kinds(fleet.run_solves([request]), PublishPlan)
+    assert 'Inspect' in published.result.schedule.jobs
+    fleet.execute()
+    assert fleet.state() == MissionState.COMPLETE
+    assert fleet.status().jobs_total == 13
+
+
+def test_resume_rebuilds_the_mission_and_replans_above_what_robots_follow(problem):
+    from fjsp_planner.execution.journal import DoneRecord, PlanRecord
+
+    fleet = executing(problem)
+    first = kinds(fleet.effects, PublishPlan)[0]
+    fleet.wall += 8
+    fleet.execute(until=8)
+    mission = fleet.controller.mission
+    done = [DoneRecord(mission.tracker.jobs[j].done_as, 1) for j in sorted(mission.tracker.done)]
+    records = [PlanRecord(1, first.mission_start, first.result.schedule, frozenset(), ())]
+    # A new planner process: a fresh controller, the journal, and the fleet's reports.
+    restarted = Fleet(problem)
+    restarted.wall = fleet.wall
+    effects = restarted.take(restarted.controller.resume(
+        'm1', problem, SETTINGS, fleet.wall, records + done[:-1], restarted.wall))
+    assert 'resumed after a planner restart' in \
+        notes(effects, MissionEventKind.MISSION_STARTED)[0].reasons[0]
+    restarted.following = {'mission_id': 'm1', 'revision': 3}  # what the robots follow
+    restarted.heartbeat()
+    # The agents' event histories bring back the job whose done record was lost.
+    last = done[-1].assignment
+    for robot, q in last.robots.items():
+        restarted.event(EventKind.STARTED, robot, last.job, float(last.start), revision=1)
+        restarted.event(EventKind.OPERATION_DONE, robot, last.job,
+                        float(last.start + problem.duration(robot, q)), revision=1)
+    assert restarted.controller.mission.tracker.done == mission.tracker.done
+    request = restarted.tick_until_solve()
+    assert len(request.reasons) == 1 and 'planner restarted' in request.reasons[0]
+    assert set(request.state.done) == set(mission.tracker.done)
+    (published,) = kinds(restarted.run_solves([request]), PublishPlan)
+    assert published.revision == 4
+    # Done jobs are not redone (a done jig job may go on, continued, while its hold lasts).
+    restarted_jobs = set(published.result.schedule.jobs) - published.continued
+    assert not restarted_jobs & set(mission.tracker.done)
+
+
+def test_a_resumed_mission_waits_for_each_robots_history_as_far_as_its_state_says(problem):
+    """Under load, the agents' event histories reached a restarted planner later than the
+    half second it used to wait after discovering their writers: it re-planned as if
+    nothing had happened meanwhile, and the robots redid every job since the restart. Each
+    robot's state names the latest event it published; the re-plan waits for it."""
+    from fjsp_planner.execution.journal import PlanRecord
+
+    fleet = executing(problem)
+    first = kinds(fleet.effects, PublishPlan)[0]
+    plan = first.result.schedule
+    job = min(plan.jobs.values(), key=lambda a: a.start)
+    records = [PlanRecord(1, first.mission_start, plan, frozenset(), (),
+                          incarnations=dict(first.incarnations))]
+    restarted = Fleet(problem)
+    restarted.wall = fleet.wall + float(job.end) + 1
+    restarted.take(restarted.controller.resume('m1', problem, SETTINGS, fleet.wall, records,
+                                               restarted.wall))
+    # Each robot of the job did its part while no planner ran; its state says so.
+    last = {robot: f'{robot}/done-{job.job}' for robot in job.robots}
+    restarted.following = {'mission_id': 'm1', 'revision': 1}
+
+    def tick():
+        restarted.wall += 0.1
+        for robot in ROBOTS:
+            restarted.report(robot, last_event=last.get(robot, ''))
+        return restarted.take(restarted.controller.tick(restarted.wall))
+
+    for _ in range(10):
+        assert not kinds(tick(), Solve)
+    for robot, q in job.robots.items():
+        for kind, at, name in ((EventKind.STARTED, job.start, f'{robot}/start-{job.job}'),
+                               (EventKind.OPERATION_DONE,
+                                job.start + problem.duration(robot, q), last[robot])):
+            restarted.controller.task_event(EventReport(name, 'm1', kind, robot, job.job, 1,
+                                                        float(at)), restarted.wall)
+    (request,) = kinds(tick() + tick(), Solve)
+    assert job.job in request.state.done
+
+
+def test_a_resumed_mission_waits_for_a_missing_history_no_longer_than_the_robot_wait(problem):
+    from fjsp_planner.execution.journal import PlanRecord
+
+    fleet = executing(problem)
+    first = kinds(fleet.effects, PublishPlan)[0]
+    records = [PlanRecord(1, first.mission_start, first.result.schedule, frozenset(), ())]
+    restarted = Fleet(problem)
+    restarted.wall = fleet.wall + 1
+    restarted.take(restarted.controller.resume('m1', problem, SETTINGS, fleet.wall, records,
+                                               restarted.wall))
+    restarted.following = {'mission_id': 'm1', 'revision': 1, 'last_event': 'never/sent'}
+    waited = []
+    for _ in range(60):
+        if kinds(restarted.tick(), Solve):
+            break
+        waited.append(restarted.wall)
+    assert SETTINGS.robot_wait_timeout - 0.2 <= waited[-1] - (fleet.wall + 1) \
+        <= SETTINGS.robot_wait_timeout + 0.1
+
+
+def test_an_agent_restarted_while_the_planner_was_down_has_its_job_redone(problem):
+    """Found by the soak (truss: R1 killed, the planner killed, R1 started again, then the
+    planner): R2 had begun a job with R1, whose new process knew nothing of it. The resumed
+    planner saw a healthy R1 and let the job go on, and R1 did its part alone 70 units later.
+    The journal names the agent each plan was made for: the job is aborted and redone."""
+    from fjsp_planner.execution.journal import DoneRecord, PlanRecord
+
+    fleet = executing(problem)
+    first = kinds(fleet.effects, PublishPlan)[0]
+    assert first.incarnations == dict.fromkeys(ROBOTS, 1)
+    plan = first.result.schedule
+    job = min((a for a in plan.jobs.values() if len(a.robots) >= 2), key=lambda a: a.start)
+    fleet.wall += float(job.start) + 0.1
+    fleet.execute(until=float(job.start) + 0.1)
+    tracker = fleet.controller.mission.tracker
+    assert job.job in tracker.running
+    done = [DoneRecord(tracker.jobs[j].done_as, 1) for j in sorted(tracker.done)]
+    records = [PlanRecord(1, first.mission_start, plan, frozenset(), (),
+                          incarnations=dict(first.incarnations))]
+    # The planner dies; one robot of the job restarts; a new planner resumes.
+    gone, stayed = sorted(job.robots)[:2]
+    restarted = Fleet(problem)
+    restarted.wall = fleet.wall + 1
+    restarted.incarnations[gone] = 2
+    restarted.take(restarted.controller.resume('m1', problem, SETTINGS, fleet.wall,
+                                               records + done, restarted.wall))
+    restarted.following = {'mission_id': 'm1', 'revision': 1}
+    restarted.heartbeat()
+    # The robot that stayed still has its history; the restarted one lost its own.
+    restarted.event(EventKind.STARTED, stayed, job.job, float(job.start), revision=1)
+    request = restarted.tick_until_solve()
+    aborted = notes(restarted.effects, MissionEventKind.JOB_ABORTED)
+    assert [n.job for n in aborted] == [job.job]
+    assert f"robot '{gone}' restarted while the planner was down" in aborted[0].reasons[0]
+    assert job.job not in request.state.running
+    (published,) = kinds(restarted.run_solves([request]), PublishPlan)
+    assert job.job in published.result.schedule.jobs
+    assert job.job not in published.continued
+    assert published.incarnations[gone] == 2
+
+
+def repaired_after_a_failure(problem):
+    """MARC1 fails at 2: (the fleet, the repaired plan published, the effects of the repair)."""
+    fleet = executing(problem)
+    fleet.wall += 2
+    fleet.execute(until=2)
+    fleet.failures['MARC1'] += 1
+    fleet.report('MARC1', RobotMode.FAILED)
+    (repair_request,) = kinds(fleet.tick(), Solve)
+    effects = fleet.run_solves([repair_request])
+    (repaired,) = kinds(effects, PublishPlan)
+    return fleet, repaired, effects
+
+
+def test_a_repaired_plan_is_published_at_once_then_bettered(problem):
+    fleet, repaired, effects = repaired_after_a_failure(problem)
+    searches = [e for e in kinds(effects, Solve) if e.kind == 'improve']
+    if repaired.result.status == 'optimal':
+        assert not searches  # nothing to better
+        return
+    (search,) = searches
+    # The robots go on with the repaired plan until the search's plan can reach them.
+    assert search.frozen_until == pytest.approx(fleet.controller.now_units(
+        fleet.wall + search.time_limit + IMPROVE_REACH))
+    better = kinds(fleet.run_solves([search], improve_too=True), PublishPlan)
+    for plan in better:
+        assert plan.revision == repaired.revision + 1
+        assert plan.result.makespan < repaired.result.makespan
+        assert plan.reasons[0].startswith('a better plan: makespan')
+        begun = {name for name, a in repaired.result.schedule.jobs.items()
+                 if a.start < search.frozen_until}
+        assert begun <= plan.continued
+
+
+def test_a_better_plan_is_searched_from_again_until_a_search_finds_no_better(problem):
+    """The searches' outcomes are made up (the repaired plan, said to be better), so that
+    both turns are taken whatever CP-SAT would find."""
+    fleet, repaired, effects = repaired_after_a_failure(problem)
+    (search,) = [e for e in kinds(effects, Solve) if e.kind == 'improve']
+    published = search.published
+    effects = fleet.take(fleet.controller.solved(search.token, Improvement(published, True),
+                                                 fleet.wall))
+    (better,) = kinds(effects, PublishPlan)
+    assert better.revision == repaired.revision + 1
+    (again,) = [e for e in kinds(effects, Solve) if e.kind == 'improve']
+    assert again.published is published and again.token != search.token
+    assert again.time_limit == search.time_limit == SETTINGS.replan_time_limit
+    # Searches that find nothing better double in length, up to 16 re-plan limits.
+    limits = []
+    while True:
+        effects = fleet.take(fleet.controller.solved(again.token,
+                                                     Improvement(published, False), fleet.wall))
+        assert not kinds(effects, PublishPlan)
+        searches = [e for e in kinds(effects, Solve) if e.kind == 'improve']
+        if not searches:
+            break
+        (again,) = searches
+        limits.append(again.time_limit)
+    assert limits == [4.0, 8.0, 16.0, 32.0]
+
+
+def test_a_better_plan_that_changes_what_the_robots_started_meanwhile_is_dropped(problem):
+    """Robots may start jobs ahead of the plan, beyond what the search kept as it is. A
+    plan that gives one of those to other robots cannot be followed: it is dropped with a
+    warning, and a search twice as long starts from the published plan. The search's
+    outcome is made up so that it does change such a job."""
+    fleet, repaired, effects = repaired_after_a_failure(problem)
+    (search,) = [e for e in kinds(effects, Solve) if e.kind == 'improve']
+    published = search.published
+    fleet.wall += 10
+    fleet.execute(until=12)
+    moved = next(name for name, a in sorted(published.schedule.jobs.items(),
+                                            key=lambda kv: kv[1].start)
+                 if name not in published.residual.problem.fixed
+                 and fleet.controller.mission.tracker.jobs[name].started)
+    job = published.schedule.jobs[moved]
+    other = next(r for r in ROBOTS if r not in job.robots and r != 'MARC1')
+    robots = dict(job.robots)
+    robots[other] = robots.pop(next(iter(robots)))
+    changed = replace(published.schedule, jobs={**published.schedule.jobs,
+                                                moved: replace(job, robots=robots)})
+    better = Replan(published.residual, replace(published.result, schedule=changed), [])
+    effects = fleet.take(fleet.controller.solved(search.token, Improvement(better, True),
+                                                 fleet.wall))
+    assert not kinds(effects, PublishPlan)
+    (warning,) = notes(effects, MissionEventKind.WARNING)
+    assert 'dropped' in warning.reasons[0] and f"job '{moved}'" in warning.reasons[0]
+    (again,) = [e for e in kinds(effects, Solve) if e.kind == 'improve']
+    assert again.published is published
+    assert again.time_limit == 2 * search.time_limit
+    assert moved in again.started
+
+
+def test_a_search_for_a_better_plan_is_dropped_when_the_fleet_changes(problem):
+    fleet = executing(problem)
+    fleet.failures['MARC1'] += 1
+    fleet.report('MARC1', RobotMode.FAILED)
+    (repair_request,) = kinds(fleet.tick(), Solve)
+    searches = [e for e in kinds(fleet.run_solves([repair_request]), Solve)
+                if e.kind == 'improve']
+    fleet.failures['MARC2'] += 1
+    fleet.report('MARC2', RobotMode.FAILED)
+    assert kinds(fleet.tick(), Solve)  # a new repair for the second failure
+    for search in searches:
+        assert not fleet.run_solves([search], improve_too=True)

@@ -1,0 +1,73 @@
+"""The mission journal: records round-trip exactly, a line cut by a crash is ignored, and
+unfinished missions are found."""
+
+from fractions import Fraction
+
+import pytest
+
+from fjsp_planner.execution.journal import (
+    DoneRecord,
+    EndRecord,
+    JobsAddedRecord,
+    Journal,
+    JournalError,
+    MissionRecord,
+    PlanRecord,
+    journal_path,
+    journals,
+    read_journal,
+    unfinished,
+)
+from fjsp_planner.model.schedule import JobAssignment, Schedule
+
+ASSIGNMENT = JobAssignment('Ja', 0, Fraction(7, 3), Fraction(22, 3), {'MARC1': 0, 'LSMS': 0})
+SCHEDULE = Schedule({'Ja': ASSIGNMENT}, {'MARC1': ('Ja',), 'LSMS': ('Ja',), 'MARC2': ()})
+
+
+def mission(mission_id='m1', accepted=10.0):
+    return MissionRecord(mission_id, 'name: x\n', 'x', 2, -1.0, 'parameter:abc',
+                         {'time_scale': 0.1}, accepted)
+
+
+def test_records_round_trip_exactly(tmp_path):
+    path = journal_path(tmp_path, 'm1')
+    journal = Journal(path)
+    records = [mission(), PlanRecord(1, 12.5, SCHEDULE, frozenset({'Ja'}), ('r',),
+                                     {'R1': 'dock', 'R2': None}, {'R1': 7, 'R2': 12}),
+               DoneRecord(ASSIGNMENT, 1, 'planner/17/3'), JobsAddedRecord('jobs: []', ('A', 'B')),
+               PlanRecord(2, 12.5, None, frozenset(), ('cancelled',)),
+               EndRecord('cancelled', ('by test',))]
+    for record in records:
+        journal.write(record)
+    journal.close()
+    assert read_journal(path) == records
+
+
+def test_a_line_cut_short_by_a_crash_is_ignored(tmp_path):
+    path = journal_path(tmp_path, 'm1')
+    journal = Journal(path)
+    journal.write(mission())
+    journal.write(DoneRecord(ASSIGNMENT, 1))
+    journal.close()
+    with path.open('a') as f:
+        f.write('{"type": "done", "job": {"job": "J')
+    assert len(read_journal(path)) == 2
+
+
+def test_a_broken_line_inside_the_journal_is_an_error(tmp_path):
+    path = journal_path(tmp_path, 'm1')
+    path.write_text('{"type": "mission"\n{"type": "end", "state": "x", "reasons": []}\n\n')
+    with pytest.raises(JournalError, match='line 1'):
+        read_journal(path)
+
+
+def test_unfinished_missions_oldest_first(tmp_path):
+    for mission_id, accepted, ended in (('b', 2.0, False), ('a', 3.0, False), ('c', 1.0, True)):
+        journal = Journal(journal_path(tmp_path, mission_id))
+        journal.write(mission(mission_id, accepted))
+        if ended:
+            journal.write(EndRecord('complete', ()))
+        journal.close()
+    (tmp_path / 'junk.journal').write_text('not json\n\n')
+    assert [records[0].mission_id for _, records in journals(tmp_path)] == ['c', 'b', 'a']
+    assert [records[0].mission_id for _, records in unfinished(tmp_path)] == ['b', 'a']

@@ -1,0 +1,201 @@
+"""fjsp-solve as a user runs it: exit codes, printed table, JSON shape, Gantt file."""
+
+import ctypes
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from repo_paths import PAPER, REPO
+
+
+def fjsp_solve(*args, cwd=None):
+    env = dict(os.environ, PYTHONPATH=str(REPO / 'src' / 'fjsp_planner'))
+    return subprocess.run([sys.executable, '-m', 'fjsp_planner.cli', *map(str, args)],
+                          capture_output=True, text=True, env=env, cwd=cwd, timeout=120)
+
+
+def test_paper_instance_json_and_gantt(tmp_path):
+    out, png = tmp_path / 'plan.json', tmp_path / 'plan.png'
+    run = fjsp_solve(PAPER, '--time-limit', 20, '--json', out, '--gantt', png)
+    assert run.returncode == 0, run.stderr
+    assert 'status optimal' in run.stdout and 'makespan 32' in run.stdout
+    for robot in ('Assembler', 'LSMS', 'MARC1', 'MARC2'):
+        assert robot in run.stdout
+    data = json.loads(out.read_text())
+    assert data['status'] == 'optimal'
+    assert data['makespan'] == 32 and data['lower_bound'] == 32 and data['gap'] == 0
+    assert isinstance(data['solve_seconds'], float)
+    assert sorted(j['name'] for j in data['jobs']) == sorted(
+        ['M1', 'M2', 'Ja', 'Jb', 'Aa', 'Ab', 'M3', 'Jc', 'Ac', 'Md', 'Jd', 'Ad'])
+    aa = next(j for j in data['jobs'] if j['name'] == 'Aa')
+    assert sorted(aa['robots'].values()) == [0, 0, 2]
+    assert set(aa) == {'name', 'plan', 'start', 'end', 'robots'}
+    assert set(data['robots']) == {'Assembler', 'LSMS', 'MARC1', 'MARC2'}
+    visits = [v for route in data['robots'].values() for v in route]
+    assert len(visits) == sum(len(j['robots']) for j in data['jobs'])
+    assert all(v['travel_start'] <= v['arrival'] <= v['start'] < v['end'] for v in visits)
+    assert png.read_bytes()[:8] == b'\x89PNG\r\n\x1a\n'
+
+
+def test_greedy_solver_and_panels(tmp_path):
+    out = tmp_path / 'plan.json'
+    run = fjsp_solve(PAPER, '--solver', 'greedy', '--panels', 2, '--shift', 30, '--json', out)
+    assert run.returncode == 0, run.stderr
+    data = json.loads(out.read_text())
+    assert data['status'] == 'feasible' and len(data['jobs']) == 24
+
+
+@pytest.mark.parametrize('args, message', [
+    (['missing.yaml'], 'missing.yaml: no such file'),
+    (['.'], '.: is a directory, not a scenario file'),
+    ([PAPER, '--panels', '0'], 'must be a positive integer'),
+    ([PAPER, '--panels', '100000'], 'panels: 100000 is more than the limit of 50'),
+    ([PAPER, '--time-limit', 'soon'], 'not a number'),
+    ([PAPER, '--time-limit', 'inf'], 'must be a finite number > 0'),
+    ([PAPER, '--solver', 'gurobi'], 'invalid choice'),
+    ([PAPER, '--shift', '-1'], "shift: '-1' is outside [0, 1e+06]"),
+    ([PAPER, '--shift', '1e-999999999'], 'shift: expected a finite number'),
+    ([PAPER, '--workers', '999999'], 'must be at most 64'),
+], ids=['missing file', 'directory', 'zero panels', 'too many panels', 'bad time limit',
+        'infinite time limit', 'unknown solver', 'negative shift', 'huge exponent',
+        'too many workers'])
+def test_bad_arguments_exit_2_with_a_message(args, message):
+    run = fjsp_solve(*args)
+    assert run.returncode == 2
+    assert message in run.stderr
+    assert 'Traceback' not in run.stderr
+
+
+@pytest.mark.parametrize('option', ['--json', '--gantt'])
+def test_an_output_that_cannot_be_written_exits_2(tmp_path, option):
+    run = fjsp_solve(PAPER, '--solver', 'greedy', option, tmp_path / 'no' / 'such' / 'out')
+    assert (run.returncode, 'Traceback' in run.stderr) == (2, False), run.stderr
+    assert run.stderr.startswith('fjsp-solve: cannot write ') and 'No such file' in run.stderr
+
+
+@pytest.mark.parametrize('old, new, message', [
+    ('{name: MARC2, type: MARC, speed: 25}', '{name: MARC2, type: MARC, sped: 25}',
+     "robot 'MARC2': unknown key 'sped'"),
+    ('weld connection point: 1, locomote: 5}', 'weld connection point: 1e300, locomote: 5}',
+     "robot type 'MARC', operation 'weld connection point': '1e300' is outside"),
+    ('{name: MARC2, type: MARC, speed: 25}', '{name: MARC2, type: MARC, speed: 1e-300}',
+     "robot 'MARC2' speed: '1e-300' is outside [1e-06, 1e+06]"),
+    ('- [0, 0, 43,', '- [0, 0, 1e30,', "distance 'M1'-'Ja': '1e30' is outside"),
+    ('{name: LSMS, type: LSMS, speed: 30}', '{name: LSMS, type: LSMS, speed: 30, '
+     'release_time: 1e300}', "robot 'LSMS' release_time: '1e300' is outside"),
+], ids=['misspelt key', 'efficiency 1e300', 'speed 1e-300', 'distance 1e30',
+        'release time 1e300'])
+def test_values_that_used_to_crash_the_solver_exit_2(tmp_path, old, new, message):
+    bad = tmp_path / 'bad.yaml'
+    text = PAPER.read_text()
+    assert old in text
+    bad.write_text(text.replace(old, new, 1))
+    run = fjsp_solve(bad)
+    assert (run.returncode, 'Traceback' in run.stderr) == (2, False), run.stderr
+    assert message in run.stderr
+    assert len(run.stderr.splitlines()) == 2, run.stderr        # the heading and the reason
+
+
+@pytest.mark.parametrize('name, content, message', [
+    ('latin.yaml', b'name: caf\xe9\n', 'not UTF-8 text (byte 0xe9 at offset 9)'),
+    ('big.fjs', b'1 2\n1 1 1 1e23\n', "time on machine 1: '1e23' is outside [0, 1e+06]"),
+], ids=['non-UTF-8 YAML', '.fjs time 1e23'])
+def test_unreadable_files_exit_2(tmp_path, name, content, message):
+    path = tmp_path / name
+    path.write_bytes(content)
+    run = fjsp_solve(path)
+    assert (run.returncode, 'Traceback' in run.stderr) == (2, False), run.stderr
+    assert message in run.stderr
+
+
+def test_invalid_scenario_lists_every_problem(tmp_path):
+    bad = tmp_path / 'bad.yaml'
+    bad.write_text(PAPER.read_text().replace('type: MARC, speed: 25', 'type: Rover, speed: 25')
+                   .replace('- [Jd, Ad]', '- [Jd, Zz]'))
+    run = fjsp_solve(bad)
+    assert run.returncode == 2
+    assert "unknown robot type 'Rover'" in run.stderr
+    assert "unknown job 'Zz'" in run.stderr
+    assert 'Traceback' not in run.stderr
+
+
+def _status(pid) -> dict[str, str]:
+    try:
+        lines = Path(f'/proc/{pid}/status').read_text().splitlines()
+    except OSError:
+        return {}
+    return dict(line.split(':\t', 1) for line in lines if ':\t' in line)
+
+
+def _wait_for(process, condition, what, timeout=60):
+    """Poll the child's /proc status until `condition(status)` (bounded)."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        assert process.poll() is None, f'fjsp-solve ended before {what}'
+        if condition(_status(process.pid)):
+            return
+        time.sleep(0.02)
+    pytest.fail(f'fjsp-solve never got to {what} within {timeout} s')
+
+
+def _handles_sigterm(status):
+    return int(status.get('SigCgt', '0'), 16) & (1 << (signal.SIGTERM - 1))
+
+
+def _threads(status):
+    return int(status.get('Threads', '0'))
+
+
+def _signal_a_thread_other_than_the_main_one(pid, signum):
+    others = sorted(int(t) for t in os.listdir(f'/proc/{pid}/task') if int(t) != pid)
+    libc = ctypes.CDLL(None, use_errno=True)
+    if libc.tgkill(pid, others[-1], signum) != 0:
+        raise OSError(ctypes.get_errno(), 'tgkill failed')
+
+
+# Each case: the stage at which the signal lands, recognised from outside through /proc.
+# The main thread installs the handlers, then imports OR-Tools (which starts one thread of its
+# own), then starts the worker (3 threads): it loads the scenario (for seconds at 50 panels),
+# solves greedily, then CP-SAT adds its 2 search threads.
+@pytest.mark.skipif(not Path('/proc/self/status').exists(), reason='needs Linux /proc')
+@pytest.mark.parametrize('signum, panels, ready, stage, to_thread', [
+    (signal.SIGINT, 10, _handles_sigterm, None, False),
+    (signal.SIGTERM, 50, lambda s: _threads(s) >= 3, 'loading the scenario', False),
+    (signal.SIGINT, 10, lambda s: _threads(s) >= 5, 'solving', False),
+    (signal.SIGTERM, 10, lambda s: _threads(s) >= 5, 'solving', False),
+    (signal.SIGTERM, 10, lambda s: _threads(s) >= 5, 'solving', True),
+], ids=['SIGINT at start', 'SIGTERM while loading', 'SIGINT while solving',
+        'SIGTERM while solving', 'SIGTERM landing on a CP-SAT thread'])
+def test_signals_stop_it_at_once_with_one_line(signum, panels, ready, stage, to_thread):
+    """The kernel hands a signal sent to the process to any thread not blocking it, mostly
+    the main one; when it chose another, fjsp-solve went on for its whole time limit."""
+    env = dict(os.environ, PYTHONPATH=str(REPO / 'src' / 'fjsp_planner'))
+    process = subprocess.Popen(
+        [sys.executable, '-m', 'fjsp_planner.cli', PAPER, '--panels', str(panels),
+         '--time-limit', '120'], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        env=env)
+    try:
+        _wait_for(process, ready, stage or 'installing its signal handlers')
+        if to_thread:
+            _signal_a_thread_other_than_the_main_one(process.pid, signum)
+        else:
+            process.send_signal(signum)
+        sent = time.monotonic()
+        _, stderr = process.communicate(timeout=30)
+        waited = time.monotonic() - sent
+    finally:
+        process.kill()
+        process.wait()
+    name = signal.Signals(signum).name
+    assert process.returncode == 128 + signum, stderr
+    assert stderr.startswith(f'fjsp-solve: stopped by {name} while '), stderr
+    assert len(stderr.splitlines()) == 1, stderr
+    if stage is not None:
+        assert stderr.strip().endswith(stage), stderr
+    assert waited < 10, f'took {waited:.1f} s to stop'   # the time limit is 120 s
