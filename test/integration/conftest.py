@@ -12,9 +12,16 @@ if shutil.which('ros2') is None or 'AMENT_PREFIX_PATH' not in os.environ:
 
 # The harness's fixture, as a user's conftest gets it with pytest_plugins (which pytest
 # allows only in the top-level conftest, and the core tests need no ROS).
-from fjsp_planner.testing import (  # noqa: E402, F401
-    fjsp_fleet,
-    fjsp_network,
-    pytest_collection_modifyitems,
-    ros_domain,
-)
+from fjsp_planner import testing  # noqa: E402
+from fjsp_planner.testing import fjsp_fleet, fjsp_network, ros_domain  # noqa: E402, F401
+
+HERE = os.path.dirname(__file__)
+
+
+def pytest_collection_modifyitems(items) -> None:
+    """Every test here starts processes: marked `integration`, so the fast loop
+    (`-m "not integration and not slow"`) leaves them out."""
+    for item in items:
+        if str(item.path).startswith(HERE):
+            item.add_marker(pytest.mark.integration)
+    testing.pytest_collection_modifyitems(items)

@@ -1,4 +1,4 @@
-"""The planner node: ROS plumbing around the mission controller (`execution/mission/controller.py`).
+"""The planner node: ROS plumbing around the mission controller (`execution/mission/`).
 
 It turns robot states and task events into controller inputs, runs the solves the controller
 asks for in a worker thread (a guard condition wakes the executor the moment one finishes),
