@@ -30,8 +30,8 @@ from repo_paths import PAPER
     (['run', 'robot_agents', 'no_such_agent'], 1, 'No executable found'),
     (['run', 'fjsp_planner', 'fleet'], 2, 'the following arguments are required: scenario'),
     (['run', 'fjsp_planner', 'fleet', 'no_such_scenario'], 2,
-     'no_such_scenario: no such scenario file (installed: antenna.yaml, solar_panel.yaml, '
-     'truss.yaml)'),
+     'no_such_scenario: no such scenario file (installed: antenna.yaml, habitat.yaml, '
+     'solar_panel.yaml, truss.yaml)'),
     (['run', 'fjsp_planner', 'fleet', 'truss', '--panels', '0'], 2,
      'argument --panels: must be > 0, got 0'),
     (['run', 'fjsp_planner', 'fleet', 'truss', '--time-scale', 'fast'], 2,
