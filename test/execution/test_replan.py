@@ -19,6 +19,7 @@ from dataclasses import replace
 from fractions import Fraction
 
 import pytest
+from replan_checks import check_replan_result
 
 from fjsp_planner.execution.replan import (
     ExecutionState,
@@ -252,21 +253,7 @@ def test_kept_jig_job_needs_the_executed_schedule(small):
 
 def check_replan(problem, previous, state, **limits):
     """Re-plan, and check what every re-plan must satisfy whatever the solver's choices."""
-    result = replan(problem, previous, state, **limits)
-    assert result.problems == []
-    schedule = result.schedule
-    failed = {name for name, r in state.robots.items() if not r.healthy}
-    assert not failed & set().union(*(a.robots for a in schedule.jobs.values()))
-    assert all(not schedule.sequences.get(name) for name in failed)
-    # Finished jobs are not redone; a kept jig job stays exactly as it was posed.
-    redone = state.done & set(schedule.jobs)
-    assert redone == set(result.residual.kept) | set(result.residual.voided)
-    for name in result.residual.kept:
-        fixed = result.residual.problem.fixed[name]
-        assert (schedule.jobs[name].start, schedule.jobs[name].end) == (fixed.start, fixed.end)
-    assert all(a.start >= state.now for name, a in schedule.jobs.items()
-               if name not in result.residual.problem.fixed)
-    return result
+    return check_replan_result(state, replan(problem, previous, state, **limits))
 
 
 # (now, failed robots, hand-computed optimum of what remains, why)
