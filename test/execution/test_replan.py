@@ -19,7 +19,6 @@ from dataclasses import replace
 from fractions import Fraction
 
 import pytest
-from replan_checks import check_replan_result
 
 from fjsp_planner.execution.replan import (
     ExecutionState,
@@ -38,6 +37,7 @@ from fjsp_planner.model.schedule import JobAssignment, Schedule
 from fjsp_planner.model.validate import validate
 from fjsp_planner.solving.solve import solve
 
+from replan_checks import check_replan_result
 from repo_paths import PAPER
 
 
