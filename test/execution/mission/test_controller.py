@@ -10,20 +10,12 @@ from fractions import Fraction
 import pytest
 
 from fjsp_common.vocabulary import EventKind, MissionEventKind, MissionState, RobotMode
-from fjsp_planner.execution.mission.controller import (
-    DUE_GRACE,
-    IMPROVE_REACH,
-    PLAN_RESEND_AFTER,
-    EventReport,
-    JobDone,
-    MissionController,
-    Note,
-    PublishPlan,
-    ResendPlan,
-    RobotReport,
-    Settings,
-    Solve,
-)
+from fjsp_planner.execution.mission.continuation import DUE_GRACE
+from fjsp_planner.execution.mission.controller import IMPROVE_REACH, MissionController
+from fjsp_planner.execution.mission.effects import JobDone, Note, PublishPlan, ResendPlan, Solve
+from fjsp_planner.execution.mission.liveness import PLAN_RESEND_AFTER
+from fjsp_planner.execution.mission.reports import EventReport, RobotReport
+from fjsp_planner.execution.mission.settings import Settings
 from fjsp_planner.execution.replan import Improvement, Replan, improve, repair
 from fjsp_planner.model.scenario import load_scenario
 from fjsp_planner.model.schedule import Schedule

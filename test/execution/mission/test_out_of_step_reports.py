@@ -16,14 +16,10 @@ import pytest
 
 from fjsp_common.vocabulary import EventKind, MissionState, RobotMode
 from fjsp_planner.execution.journal import PlanRecord
-from fjsp_planner.execution.mission.controller import (
-    EventReport,
-    MissionController,
-    PublishPlan,
-    RobotReport,
-    Settings,
-    Solve,
-)
+from fjsp_planner.execution.mission.controller import MissionController
+from fjsp_planner.execution.mission.effects import PublishPlan, Solve
+from fjsp_planner.execution.mission.reports import EventReport, RobotReport
+from fjsp_planner.execution.mission.settings import Settings
 from fjsp_planner.execution.replan import replan
 from fjsp_planner.execution.tracking import MissionTracker
 from fjsp_planner.model.scenario import load_scenario

@@ -65,17 +65,10 @@ from fjsp_planner.execution.journal import (
     journal_path,
     journals,
 )
-from fjsp_planner.execution.mission.controller import (
-    EventReport,
-    JobDone,
-    MissionController,
-    Note,
-    PublishPlan,
-    ResendPlan,
-    RobotReport,
-    Settings,
-    Solve,
-)
+from fjsp_planner.execution.mission.controller import MissionController
+from fjsp_planner.execution.mission.effects import JobDone, Note, PublishPlan, ResendPlan, Solve
+from fjsp_planner.execution.mission.reports import EventReport, RobotReport
+from fjsp_planner.execution.mission.settings import Settings
 from fjsp_planner.execution.replan import improve, repair
 from fjsp_planner.execution.tracking import Ignored
 from fjsp_planner.model.extension import extend
