@@ -12,7 +12,14 @@ import pytest
 from fjsp_common.vocabulary import EventKind, MissionEventKind, MissionState, RobotMode
 from fjsp_planner.execution.mission.continuation import DUE_GRACE
 from fjsp_planner.execution.mission.controller import IMPROVE_REACH, MissionController
-from fjsp_planner.execution.mission.effects import JobDone, Note, PublishPlan, ResendPlan, Solve
+from fjsp_planner.execution.mission.effects import (
+    JobDone,
+    Note,
+    PublishPlan,
+    ResendPlan,
+    Solve,
+    SolveKind,
+)
 from fjsp_planner.execution.mission.liveness import PLAN_RESEND_AFTER
 from fjsp_planner.execution.mission.reports import EventReport, RobotReport
 from fjsp_planner.execution.mission.settings import Settings
@@ -101,11 +108,12 @@ class Fleet:
         with `improve_too`); the effects of their outcomes."""
         out = []
         for effect in list(self.effects if effects is None else effects):
-            if not isinstance(effect, Solve) or (effect.kind == 'improve' and not improve_too):
+            if not isinstance(effect, Solve) or (effect.kind == SolveKind.IMPROVE
+                                                 and not improve_too):
                 continue
-            if effect.kind == 'plan':
+            if effect.kind == SolveKind.PLAN:
                 outcome = solve(effect.problem, time_limit=effect.time_limit)
-            elif effect.kind == 'repair':
+            elif effect.kind == SolveKind.REPAIR:
                 outcome = repair(effect.problem, effect.previous, effect.state,
                                  time_limit=effect.time_limit)
             else:
@@ -180,7 +188,7 @@ def test_first_plan_waits_for_every_robot_then_solves_the_scenario(problem):
     assert not kinds(fleet.tick(robots=ROBOTS[:3]), Solve)
     fleet.heartbeat()
     (request,) = kinds(fleet.tick(), Solve)
-    assert request.kind == 'plan' and request.problem is problem  # nothing moved: as given
+    assert request.kind == SolveKind.PLAN and request.problem is problem  # nothing moved: as given
     assert fleet.state() == MissionState.PLANNING
     (published,) = kinds(fleet.run_solves(), PublishPlan)
     assert published.revision == 1 and published.result.makespan == 32
@@ -223,7 +231,7 @@ def test_failure_replans_without_the_robot(problem):
     effects = fleet.report('MARC1', RobotMode.FAILED)
     assert notes(effects, MissionEventKind.ROBOT_FAILED)
     (request,) = kinds(fleet.tick(), Solve)
-    assert request.kind == 'repair' and "robot 'MARC1' failed" in request.reasons
+    assert request.kind == SolveKind.REPAIR and "robot 'MARC1' failed" in request.reasons
     assert not request.state.robots['MARC1'].healthy
     (published,) = kinds(fleet.run_solves(), PublishPlan)
     assert published.revision == 2 and 'MARC1' not in published.result.schedule.sequences
@@ -819,7 +827,7 @@ def repaired_after_a_failure(problem):
 
 def test_a_repaired_plan_is_published_at_once_then_bettered(problem):
     fleet, repaired, effects = repaired_after_a_failure(problem)
-    searches = [e for e in kinds(effects, Solve) if e.kind == 'improve']
+    searches = [e for e in kinds(effects, Solve) if e.kind == SolveKind.IMPROVE]
     if repaired.result.status == 'optimal':
         assert not searches  # nothing to better
         return
@@ -841,13 +849,13 @@ def test_a_better_plan_is_searched_from_again_until_a_search_finds_no_better(pro
     """The searches' outcomes are made up (the repaired plan, said to be better), so that
     both turns are taken whatever CP-SAT would find."""
     fleet, repaired, effects = repaired_after_a_failure(problem)
-    (search,) = [e for e in kinds(effects, Solve) if e.kind == 'improve']
+    (search,) = [e for e in kinds(effects, Solve) if e.kind == SolveKind.IMPROVE]
     published = search.published
     effects = fleet.take(fleet.controller.solved(search.token, Improvement(published, True),
                                                  fleet.wall))
     (better,) = kinds(effects, PublishPlan)
     assert better.revision == repaired.revision + 1
-    (again,) = [e for e in kinds(effects, Solve) if e.kind == 'improve']
+    (again,) = [e for e in kinds(effects, Solve) if e.kind == SolveKind.IMPROVE]
     assert again.published is published and again.token != search.token
     assert again.time_limit == search.time_limit == SETTINGS.replan_time_limit
     # Searches that find nothing better double in length, up to 16 re-plan limits.
@@ -856,7 +864,7 @@ def test_a_better_plan_is_searched_from_again_until_a_search_finds_no_better(pro
         effects = fleet.take(fleet.controller.solved(again.token,
                                                      Improvement(published, False), fleet.wall))
         assert not kinds(effects, PublishPlan)
-        searches = [e for e in kinds(effects, Solve) if e.kind == 'improve']
+        searches = [e for e in kinds(effects, Solve) if e.kind == SolveKind.IMPROVE]
         if not searches:
             break
         (again,) = searches
@@ -870,7 +878,7 @@ def test_a_better_plan_that_changes_what_the_robots_started_meanwhile_is_dropped
     warning, and a search twice as long starts from the published plan. The search's
     outcome is made up so that it does change such a job."""
     fleet, repaired, effects = repaired_after_a_failure(problem)
-    (search,) = [e for e in kinds(effects, Solve) if e.kind == 'improve']
+    (search,) = [e for e in kinds(effects, Solve) if e.kind == SolveKind.IMPROVE]
     published = search.published
     fleet.wall += 10
     fleet.execute(until=12)
@@ -890,7 +898,7 @@ def test_a_better_plan_that_changes_what_the_robots_started_meanwhile_is_dropped
     assert not kinds(effects, PublishPlan)
     (warning,) = notes(effects, MissionEventKind.WARNING)
     assert 'dropped' in warning.reasons[0] and f"job '{moved}'" in warning.reasons[0]
-    (again,) = [e for e in kinds(effects, Solve) if e.kind == 'improve']
+    (again,) = [e for e in kinds(effects, Solve) if e.kind == SolveKind.IMPROVE]
     assert again.published is published
     assert again.time_limit == 2 * search.time_limit
     assert moved in again.started
@@ -902,7 +910,7 @@ def test_a_search_for_a_better_plan_is_dropped_when_the_fleet_changes(problem):
     fleet.report('MARC1', RobotMode.FAILED)
     (repair_request,) = kinds(fleet.tick(), Solve)
     searches = [e for e in kinds(fleet.run_solves([repair_request]), Solve)
-                if e.kind == 'improve']
+                if e.kind == SolveKind.IMPROVE]
     fleet.failures['MARC2'] += 1
     fleet.report('MARC2', RobotMode.FAILED)
     assert kinds(fleet.tick(), Solve)  # a new repair for the second failure

@@ -17,7 +17,7 @@ import pytest
 from fjsp_common.vocabulary import EventKind, MissionState, RobotMode
 from fjsp_planner.execution.journal import PlanRecord
 from fjsp_planner.execution.mission.controller import MissionController
-from fjsp_planner.execution.mission.effects import PublishPlan, Solve
+from fjsp_planner.execution.mission.effects import PublishPlan, Solve, SolveKind
 from fjsp_planner.execution.mission.reports import EventReport, RobotReport
 from fjsp_planner.execution.mission.settings import Settings
 from fjsp_planner.execution.replan import replan
@@ -66,7 +66,7 @@ class Planner:
         pending, self.solves = self.solves, []
         for request in pending:
             try:
-                if request.kind == 'plan':
+                if request.kind == SolveKind.PLAN:
                     outcome = solve(request.problem, time_limit=request.time_limit)
                 else:
                     outcome = replan(request.problem, request.previous, request.state,

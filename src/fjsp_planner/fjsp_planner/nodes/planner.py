@@ -66,7 +66,14 @@ from fjsp_planner.execution.journal import (
     journals,
 )
 from fjsp_planner.execution.mission.controller import MissionController
-from fjsp_planner.execution.mission.effects import JobDone, Note, PublishPlan, ResendPlan, Solve
+from fjsp_planner.execution.mission.effects import (
+    JobDone,
+    Note,
+    PublishPlan,
+    ResendPlan,
+    Solve,
+    SolveKind,
+)
 from fjsp_planner.execution.mission.reports import EventReport, RobotReport
 from fjsp_planner.execution.mission.settings import Settings
 from fjsp_planner.execution.replan import improve, repair
@@ -620,12 +627,12 @@ class PlannerNode(Node):
 
     def solve(self, request: Solve) -> None:
         workers = self.get_parameter('workers').value
-        if request.kind == 'plan':
+        if request.kind == SolveKind.PLAN:
             self.get_logger().info(f'solving with {self.solver}, time limit '
                                    f'{request.time_limit:g} s, {workers} workers')
             future = self.pool.submit(solve, request.problem, solver=self.solver,
                                       time_limit=request.time_limit, workers=workers)
-        elif request.kind == 'repair':
+        elif request.kind == SolveKind.REPAIR:
             self.replan_began = time.monotonic()
             now = self.controller.now_units(self.wall())
             self.get_logger().warning(f're-planning at t={now:.2f}: '

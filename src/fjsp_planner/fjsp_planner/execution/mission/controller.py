@@ -29,6 +29,7 @@ from fjsp_planner.execution.mission.effects import (
     Note,
     PublishPlan,
     Solve,
+    SolveKind,
     StatusView,
 )
 from fjsp_planner.execution.mission.liveness import Liveness
@@ -62,7 +63,7 @@ RETRY_FAILED_REPLAN = 1.0
 @dataclass
 class Solving:
     token: int
-    kind: str
+    kind: SolveKind
     problem: Problem
     """What was posed: for a first plan, the problem the schedule will be of."""
     fleet: dict[str, tuple[int, int]]
@@ -402,7 +403,8 @@ class MissionController:
                                    + self._missing(unavailable))
             posed = residual.problem
         mission.state = MissionState.PLANNING
-        return [self._solve(mission, 'plan', fleet, (), posed, mission.settings.time_limit)]
+        return [self._solve(mission, SolveKind.PLAN, fleet, (), posed,
+                            mission.settings.time_limit)]
 
     def _initial_state(self, mission: Mission, fleet) -> ExecutionState | None:
         """Where the robots are at the mission start, when that is not simply what the
@@ -437,7 +439,7 @@ class MissionController:
         mission.state = MissionState.REPLANNING
         mission.improving = None  # a search from an older state would only be discarded
         limit = min(REPAIR_LIMIT, mission.settings.replan_time_limit)
-        return [self._solve(mission, 'repair', fleet, reasons, mission.problem, limit,
+        return [self._solve(mission, SolveKind.REPAIR, fleet, reasons, mission.problem, limit,
                             mission.schedule, state)]
 
     def _solve(self, mission, kind, fleet, reasons, problem, time_limit, previous=None,
@@ -452,20 +454,20 @@ class MissionController:
         robots go on with what it has them do until the search's plan can reach them."""
         self._tokens += 1
         limit = time_limit or mission.settings.replan_time_limit
-        mission.improving = replace(solving, token=self._tokens, kind='improve',
+        mission.improving = replace(solving, token=self._tokens, kind=SolveKind.IMPROVE,
                                     time_limit=limit, published=published)
         # Robots start a job as soon as its robots and predecessors are ready, so they may
         # be ahead of the plan: what they started is kept too.
         started = frozenset(name for name, record in mission.tracker.jobs.items()
                             if record.begun)
-        return Solve(self._tokens, 'improve', published.residual.problem, limit,
+        return Solve(self._tokens, SolveKind.IMPROVE, published.residual.problem, limit,
                      state=solving.state, reasons=solving.reasons, published=published,
                      frozen_until=self._now(mission, wall + limit + IMPROVE_REACH),
                      started=started)
 
     def solved(self, token: int, outcome, wall: float) -> list[Effect]:
-        """The outcome of `Solve` `token`: a `Result` ('plan'), a `Replan` ('replan'), or
-        the ValueError the solver raised. Outcomes of superseded solves are dropped."""
+        """The outcome of `Solve` `token` (what its `SolveKind` says), or the ValueError the
+        solver raised. Outcomes of superseded solves are dropped."""
         mission = self.mission
         if mission is not None and mission.improving is not None \
                 and mission.improving.token == token:
@@ -477,7 +479,7 @@ class MissionController:
         if mission.state.ended:
             return []
         fleet_now = self._fleet(mission, wall)
-        if solving.kind == 'plan':
+        if solving.kind == SolveKind.PLAN:
             return self._first_plan(mission, solving, outcome, wall, fleet_now)
         return self._new_revision(mission, solving, outcome, wall, fleet_now)
 

@@ -9,6 +9,7 @@ again (`ResendPlan`), declare a job done (`JobDone`), tell the story of the miss
 from collections import Counter
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from enum import StrEnum
 
 from fjsp_common.vocabulary import MissionEventKind, MissionState
 from fjsp_planner.execution.replan import ExecutionState, Replan
@@ -16,16 +17,25 @@ from fjsp_planner.model.problem import Problem
 from fjsp_planner.model.schedule import JobAssignment, Result, Schedule
 
 
+class SolveKind(StrEnum):
+    """Which solve a `Solve` asks for, and so what its outcome is."""
+
+    PLAN = 'plan'
+    """The mission's first plan: `solve(problem)`, a `Result`."""
+    REPAIR = 'repair'
+    """A valid plan of what remains, at once and without search: `repair(problem, previous,
+    state)`, a `Replan`."""
+    IMPROVE = 'improve'
+    """A search for a better plan from the one just published: `improve(published)`, an
+    `Improvement`."""
+
+
 @dataclass(frozen=True)
 class Solve:
-    """Run a solve off the executor and hand its outcome to `MissionController.solved`.
-
-    kind 'plan': `solve(problem)`; kind 'repair': `repair(problem, previous, state)`, a valid
-    plan of what remains at once, without search; kind 'improve': `improve(published)`, a
-    search from the plan just published."""
+    """Run a solve off the executor and hand its outcome to `MissionController.solved`."""
 
     token: int
-    kind: str
+    kind: SolveKind
     problem: Problem
     time_limit: float
     previous: Schedule | None = None
@@ -33,12 +43,12 @@ class Solve:
     reasons: tuple[str, ...] = ()
     """Why a re-plan is needed."""
     published: Replan | None = None
-    """For 'improve': the repaired plan to search from."""
+    """For IMPROVE: the repaired plan to search from."""
     frozen_until: float | None = None
-    """For 'improve': the schedule time by which its plan reaches the robots; what the
+    """For IMPROVE: the schedule time by which its plan reaches the robots; what the
     published plan has them do until then is kept (`replan.frozen`)."""
     started: frozenset[str] = frozenset()
-    """For 'improve': the jobs the robots have started or done; they are kept too."""
+    """For IMPROVE: the jobs the robots have started or done; they are kept too."""
 
 
 @dataclass(frozen=True)
