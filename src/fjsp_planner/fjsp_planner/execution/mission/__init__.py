@@ -6,6 +6,8 @@
 - `effects`: what the controller returns for the node to carry out (solve, publish a plan,
   declare a job done, tell the story) and the mission's `StatusView`;
 - `settings`: `Settings`, how the planner runs missions;
+- `states`: the one table of moves between mission states, which the controller cannot
+  leave;
 - `liveness`: which robots' agents are live and follow the plan (heartbeats, availability,
   plan uptake);
 - `continuation`: which jobs a new plan revision lets go on rather than start afresh;

@@ -36,6 +36,7 @@ from fjsp_planner.execution.mission.liveness import Liveness
 from fjsp_planner.execution.mission.reports import EventReport, RobotReport
 from fjsp_planner.execution.mission.resume import restarted_while_down, restore, started_where
 from fjsp_planner.execution.mission.settings import Settings
+from fjsp_planner.execution.mission.states import INITIAL, check_transition
 from fjsp_planner.execution.replan import ExecutionState, Replan, RobotState, residual_problem
 from fjsp_planner.execution.tracking import Ignored, MissionTracker
 from fjsp_planner.model.problem import Problem
@@ -84,7 +85,7 @@ class Mission:
     tracker: MissionTracker
     accepted: float
     """Wall seconds when the mission was accepted."""
-    state: MissionState = MissionState.WAITING_FOR_ROBOTS
+    _state: MissionState = INITIAL
     start: float | None = None
     """Wall seconds of schedule time 0, fixed when revision 1 is published."""
     schedule: Schedule | None = None
@@ -124,6 +125,14 @@ class Mission:
     """Robot -> the revision it did not take within `plan_uptake_timeout`: it is planned
     without until it reports the latest revision."""
 
+    @property
+    def state(self) -> MissionState:
+        return self._state
+
+    def enter(self, state: MissionState) -> None:
+        """Move the mission to `state`, as `states.TRANSITIONS` allows (else it raises)."""
+        self._state = check_transition(self._state, state)
+
 
 class MissionController:
     def __init__(self, settings: Settings | None = None):
@@ -154,7 +163,7 @@ class MissionController:
         if mission is None or mission.state.ended:
             raise ValueError('no mission is running')
         mission.solving = mission.improving = None
-        mission.state = MissionState.CANCELLED
+        mission.enter(MissionState.CANCELLED)
         mission.failure = (reason,)
         effects: list[Effect] = [Note(MissionEventKind.MISSION_CANCELLED, (reason,))]
         if mission.start is not None:
@@ -178,8 +187,8 @@ class MissionController:
         if mission.solving is not None:
             # Whatever is being solved leaves the new jobs out.
             mission.solving = None
-            mission.state = (MissionState.WAITING_FOR_ROBOTS if mission.schedule is None
-                             else MissionState.EXECUTING)
+            mission.enter(MissionState.WAITING_FOR_ROBOTS if mission.schedule is None
+                          else MissionState.EXECUTING)
         if mission.schedule is not None:
             mission.pending += (reason,)
         return effects + self.tick(wall)
@@ -220,7 +229,7 @@ class MissionController:
         mission.resumed = False
         effects = restarted_while_down(mission, self.liveness, self._now(mission, wall))
         mission.planned = self._fleet(mission, wall)
-        mission.state = MissionState.EXECUTING
+        mission.enter(MissionState.EXECUTING)
         mission.pending = ('planner restarted: what remains is re-planned from where the '
                            'robots are',)
         return effects
@@ -402,7 +411,7 @@ class MissionController:
                 return self._block(mission, wall, tuple(residual.blocked)
                                    + self._missing(unavailable))
             posed = residual.problem
-        mission.state = MissionState.PLANNING
+        mission.enter(MissionState.PLANNING)
         return [self._solve(mission, SolveKind.PLAN, fleet, (), posed,
                             mission.settings.time_limit)]
 
@@ -436,7 +445,7 @@ class MissionController:
         # The tracker knows failed and offline robots; refusing and silent ones are out too.
         state = replace(state, robots={name: replace(robot, healthy=name in fleet)
                                        for name, robot in state.robots.items()})
-        mission.state = MissionState.REPLANNING
+        mission.enter(MissionState.REPLANNING)
         mission.improving = None  # a search from an older state would only be discarded
         limit = min(REPAIR_LIMIT, mission.settings.replan_time_limit)
         return [self._solve(mission, SolveKind.REPAIR, fleet, reasons, mission.problem, limit,
@@ -516,7 +525,7 @@ class MissionController:
             # The fleet changed while solving: this plan would give work to a robot that is
             # out, or leave out one that is back. The next tick re-plans from the new state,
             # for what this re-plan was for too.
-            mission.state = MissionState.EXECUTING
+            mission.enter(MissionState.EXECUTING)
             mission.pending = solving.reasons
             return [Note(MissionEventKind.WARNING,
                          ('re-plan discarded: the fleet changed while it was solved',))]
@@ -532,7 +541,7 @@ class MissionController:
         replanned: Replan = outcome
         residual = replanned.residual
         if residual.complete:
-            mission.state = MissionState.EXECUTING
+            mission.enter(MissionState.EXECUTING)
             return []
         if residual.blocked:
             return self._block(mission, wall, tuple(residual.blocked))
@@ -549,7 +558,7 @@ class MissionController:
         if progressed and not continuation.goes_on(mission.tracker, result.schedule, progressed,
                                                    continued):
             # Restarting these would redo work done meanwhile: plan again from now.
-            mission.state = MissionState.EXECUTING
+            mission.enter(MissionState.EXECUTING)
             mission.pending = solving.reasons
             return [Note(MissionEventKind.WARNING,
                          ('re-plan discarded: ' + ', '.join(f"job '{j}'" for j in progressed)
@@ -628,7 +637,7 @@ class MissionController:
         mission.schedule = result.schedule
         mission.planned_makespan = float(result.makespan)
         mission.replan_reasons = reasons
-        mission.state = MissionState.EXECUTING
+        mission.enter(MissionState.EXECUTING)
         starts = {r.name: r.start_location for r in mission.problem.robots}
         incarnations = {name: planned[0] for name, planned in mission.planned.items()}
         restarted_in = {job: tracker.jobs[job].since_revision for job in result.schedule.jobs}
@@ -671,7 +680,7 @@ class MissionController:
     def _block(self, mission, wall, reasons) -> list[Effect]:
         """Nothing can be planned until the fleet changes; the current plan stays, so the
         robots finish what they can of it."""
-        mission.state = MissionState.BLOCKED
+        mission.enter(MissionState.BLOCKED)
         if mission.blocked_since is None:
             mission.blocked_since = wall
         effects = []
@@ -684,7 +693,7 @@ class MissionController:
         return tuple(f"robot '{name}' {why}" for name, why in unavailable.items() if why)
 
     def _fail(self, mission, reasons) -> list[Effect]:
-        mission.state = MissionState.FAILED
+        mission.enter(MissionState.FAILED)
         mission.failure = reasons
         return [Note(MissionEventKind.MISSION_FAILED, reasons)]
 
@@ -694,7 +703,7 @@ class MissionController:
         violations = mission.tracker.violations()
         if violations:
             return self._fail(mission, tuple(f'executed timeline: {v}' for v in violations))
-        mission.state = MissionState.COMPLETE
+        mission.enter(MissionState.COMPLETE)
         # A mission blocked for want of robots can still complete on the plan it had.
         mission.blocked, mission.blocked_since = (), None
         executed = float(mission.tracker.projected_makespan(0))
