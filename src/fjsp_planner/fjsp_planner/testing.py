@@ -36,6 +36,7 @@ from fractions import Fraction
 
 import pytest
 
+from fjsp_common.clock import ScheduleClock, seconds
 from fjsp_common.contract import (
     EVENTS_QOS,
     JOB_STATES_TOPIC,
@@ -169,8 +170,8 @@ class Observer(Listener):
         """Schedule time now, from the first plan's mission start (-inf before any plan)."""
         if not self.plans:
             return -math.inf
-        start = self.plans[0].mission_start
-        return (time.time() - start.sec - start.nanosec * 1e-9) / self.plans[0].time_scale
+        first = self.plans[0]
+        return ScheduleClock(seconds(first.mission_start), first.time_scale).units(time.time())
 
     def jobs_done(self) -> set[str]:
         """Jobs declared done in their last attempt."""

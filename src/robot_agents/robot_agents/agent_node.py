@@ -21,6 +21,7 @@ from rclpy.node import Node
 from rclpy.time import Time as RosTime
 
 from fjsp_common.auth import PLANNER, NodeAuth
+from fjsp_common.clock import ScheduleClock, seconds
 from fjsp_common.contract import (
     EVENT_FROM_MSG,
     EVENT_HISTORY,
@@ -96,8 +97,8 @@ class RobotAgent(Node):
         self.failures = 0
         self.execution = RobotExecution(self.robot)
         self.mission_id = ''
-        self.mission_start: RosTime | None = None
-        self.scale = self.time_scale
+        self.clock: ScheduleClock | None = None
+        """The followed mission's schedule time (None before its first plan)."""
         self.robot_type = self.pinned_type
         self.refusal = ''
         """Why the latest plan received is not followed ('' when it is)."""
@@ -130,10 +131,9 @@ class RobotAgent(Node):
 
     def now_units(self) -> float | None:
         """Schedule time since the mission start, or None before the first plan."""
-        if self.mission_start is None:
+        if self.clock is None:
             return None
-        elapsed = (self.get_clock().now() - self.mission_start).nanoseconds * 1e-9
-        return elapsed / self.scale
+        return self.clock.units(self.get_clock().now().nanoseconds * 1e-9)
 
     # --- plans -------------------------------------------------------------------------
 
@@ -143,8 +143,8 @@ class RobotAgent(Node):
         log = self.get_logger()
         mission = shorten(msg.mission_id, 80)
         new_mission = msg.mission_id != self.mission_id
-        if new_mission and self.mission_start is not None \
-                and RosTime.from_msg(msg.mission_start) <= self.mission_start:
+        if new_mission and self.clock is not None \
+                and seconds(msg.mission_start) <= self.clock.mission_start:
             log.warning(f"ignoring plan of mission '{mission}': it started no later than "
                         f"mission '{self.mission_id}', which this robot follows")
             return
@@ -219,8 +219,7 @@ class RobotAgent(Node):
     def begin_mission(self, msg: Plan) -> None:
         self.execution.start_mission()
         self.mission_id = msg.mission_id
-        self.mission_start = RosTime.from_msg(msg.mission_start)
-        self.scale = self.time_scale or msg.time_scale
+        self.clock = ScheduleClock(seconds(msg.mission_start), self.time_scale or msg.time_scale)
         self.last_state = None
         early = [e for e in self.early_events if e.mission_id == msg.mission_id]
         self.early_events.clear()

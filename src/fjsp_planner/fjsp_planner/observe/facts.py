@@ -13,6 +13,7 @@ import re
 from collections.abc import Mapping
 from dataclasses import dataclass
 
+from fjsp_common.clock import ScheduleClock, seconds
 from fjsp_common.vocabulary import EventKind, MissionEventKind, MissionState, RobotMode
 
 VOCABULARIES = {
@@ -71,6 +72,13 @@ class PlanFact:
     robots: tuple[tuple[str, str], ...]
     """(robot, robot type) of every robot of the scenario, in the plan's order."""
     tasks: tuple[PlannedTask, ...]
+
+    @property
+    def clock(self) -> ScheduleClock | None:
+        """The mission's schedule time as this plan gives it (None for a time scale that is
+        not positive)."""
+        return ScheduleClock(self.mission_start, self.time_scale) if self.time_scale > 0 \
+            else None
 
 
 @dataclass(frozen=True)
@@ -143,11 +151,6 @@ _CONSTANT = re.compile(r'^\s*(?:u?int(?:8|16|32|64)|byte|char)\s+([A-Z][A-Z0-9_]
                        re.MULTILINE)
 _SECTION = re.compile(r'^={3,}\s*$', re.MULTILINE)
 _SECTION_NAME = re.compile(r'^MSG:\s*(\S+)\s*$', re.MULTILINE)
-
-
-def seconds(stamp) -> float:
-    """A `builtin_interfaces/Time` as seconds since the epoch."""
-    return stamp.sec + stamp.nanosec * 1e-9
 
 
 def short_type(type_name: str) -> str:

@@ -227,10 +227,8 @@ class MissionHistory:
 
     def units(self, stamp: float) -> float | None:
         """Schedule time of a wall stamp (None before any plan says when the mission began)."""
-        plan = self.first_plan
-        if plan is None or not plan.time_scale > 0:
-            return None
-        return (stamp - plan.mission_start) / plan.time_scale
+        clock = self.first_plan.clock if self.plans else None
+        return None if clock is None else clock.units(stamp)
 
     @property
     def scenario_id(self) -> str:

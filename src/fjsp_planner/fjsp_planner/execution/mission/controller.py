@@ -20,6 +20,7 @@ from collections import Counter
 from dataclasses import dataclass, field, replace
 from fractions import Fraction
 
+from fjsp_common.clock import ScheduleClock
 from fjsp_common.vocabulary import EventKind, MissionEventKind, MissionState, RobotMode
 from fjsp_planner.execution.journal import Record
 from fjsp_planner.execution.mission import continuation
@@ -129,6 +130,12 @@ class Mission:
     def state(self) -> MissionState:
         return self._state
 
+    @property
+    def clock(self) -> ScheduleClock | None:
+        """The mission's schedule time, once revision 1 fixed its start (None before)."""
+        return None if self.start is None else ScheduleClock(self.start,
+                                                             self.settings.time_scale)
+
     def enter(self, state: MissionState) -> None:
         """Move the mission to `state`, as `states.TRANSITIONS` allows (else it raises)."""
         self._state = check_transition(self._state, state)
@@ -227,7 +234,7 @@ class MissionController:
         if behind and waited < self.settings.robot_wait_timeout:
             return []
         mission.resumed = False
-        effects = restarted_while_down(mission, self.liveness, self._now(mission, wall))
+        effects = restarted_while_down(mission, self.liveness, self._units(mission, wall))
         mission.planned = self._fleet(mission, wall)
         mission.enter(MissionState.EXECUTING)
         mission.pending = ('planner restarted: what remains is re-planned from where the '
@@ -251,7 +258,7 @@ class MissionController:
                              (f"robot '{report.robot}' restarted: its agent lost the "
                               'operation',), job=job)
                         for job in mission.tracker.agent_restarted(
-                            report.robot, at=self._now(mission, wall))]
+                            report.robot, at=self._units(mission, wall))]
         if report.robot not in mission.tracker.robots:
             outcome = mission.tracker.record_robot_state(report.robot, report.mode, '', '',
                                                          math.nan)
@@ -269,7 +276,7 @@ class MissionController:
         before = mission.tracker.robots[report.robot].mode
         mission.tracker.record_robot_state(report.robot, report.mode, report.location,
                                            report.destination, report.busy_until,
-                                           report.current_job, at=self._now(mission, wall))
+                                           report.current_job, at=self._units(mission, wall))
         if report.mode == RobotMode.FAILED and before != RobotMode.FAILED:
             effects.append(Note(MissionEventKind.ROBOT_FAILED, robot=report.robot))
         elif before == RobotMode.FAILED and report.mode != RobotMode.FAILED:
@@ -375,7 +382,7 @@ class MissionController:
             if mission is None or change.robot not in mission.tracker.robots:
                 continue
             if not change.back:
-                mission.tracker.mark_offline(change.robot, at=self._now(mission, wall))
+                mission.tracker.mark_offline(change.robot, at=self._units(mission, wall))
                 effects.append(Note(MissionEventKind.ROBOT_OFFLINE,
                                     (f'no state for {change.silent:.1f} s',),
                                     robot=change.robot))
@@ -438,7 +445,7 @@ class MissionController:
                 ) -> list[Effect]:
         fleet = self._fleet(mission, wall)
         try:
-            state = mission.tracker.execution_state(self._now(mission, wall))
+            state = mission.tracker.execution_state(self._units(mission, wall))
         except ValueError as error:
             mission.planned = fleet
             return self._block(mission, wall, (f'cannot tell the execution state: {error}',))
@@ -471,7 +478,7 @@ class MissionController:
                             if record.begun)
         return Solve(self._tokens, SolveKind.IMPROVE, published.residual.problem, limit,
                      state=solving.state, reasons=solving.reasons, published=published,
-                     frozen_until=self._now(mission, wall + limit + IMPROVE_REACH),
+                     frozen_until=self._units(mission, wall + limit + IMPROVE_REACH),
                      started=started)
 
     def solved(self, token: int, outcome, wall: float) -> list[Effect]:
@@ -627,7 +634,7 @@ class MissionController:
                     ) -> list[str]:
         """`continuation.progressed` for the plan `solving` gave."""
         return continuation.progressed(mission.tracker, posed, solving.state, solving.fleet,
-                                       self._now(mission, wall), mission.settings.time_scale)
+                                       self._units(mission, wall), mission.settings.time_scale)
 
     def _publish(self, mission, posed, result, continued, reasons, wall) -> list[Effect]:
         tracker = mission.tracker
@@ -713,14 +720,15 @@ class MissionController:
 
     # --- views -----------------------------------------------------------------------------
 
-    def _now(self, mission: Mission, wall: float) -> float:
-        """Schedule time since the mission start (negative before it, 0 without a plan)."""
-        if mission.start is None:
-            return 0.0
-        return (wall - mission.start) / mission.settings.time_scale
+    @staticmethod
+    def _units(mission: Mission, wall: float) -> float:
+        """Schedule time at `wall` (negative before the mission start, 0 without a plan)."""
+        clock = mission.clock
+        return 0.0 if clock is None else clock.units(wall)
 
     def now_units(self, wall: float) -> float:
-        return 0.0 if self.mission is None else self._now(self.mission, wall)
+        """The running mission's schedule time at `wall` (0 without a mission or a plan)."""
+        return 0.0 if self.mission is None else self._units(self.mission, wall)
 
     def _unknown(self, robot: str) -> str:
         return (f"agent of robot '{robot}' is running, but scenario "
@@ -745,7 +753,7 @@ class MissionController:
         if mission is None:
             return None
         tracker = mission.tracker
-        now = self._now(mission, wall)
+        now_units = self._units(mission, wall)
         blocked = mission.blocked
         if mission.state == MissionState.WAITING_FOR_ROBOTS:
             blocked = tuple(f"waiting for robot '{r.name}' to report"
@@ -753,11 +761,11 @@ class MissionController:
                             if not self.liveness.heard(r.name))
         elif mission.state in (MissionState.FAILED, MissionState.CANCELLED):
             blocked = mission.failure
-        projected = float(tracker.projected_makespan(now)) if tracker.plan else math.nan
+        projected = float(tracker.projected_makespan(now_units)) if tracker.plan else math.nan
         return StatusView(
             mission.id, mission.problem.name, mission.state, tracker.revision,
             len(tracker.done), len(tracker.running), len(tracker.jobs),
-            mission.planned_makespan, projected, max(now, 0.0), blocked,
+            mission.planned_makespan, projected, max(now_units, 0.0), blocked,
             mission.replan_reasons, self.warnings(wall), Counter(tracker.ignored),
             mission.blocked_too_long)
 
