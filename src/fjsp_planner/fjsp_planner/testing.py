@@ -48,6 +48,7 @@ from fjsp_common.contract import (
     ROBOT_STATES_TOPIC,
     TASK_EVENTS_TOPIC,
 )
+from fjsp_common.revisions import Restarts, plan_attempts
 from fjsp_msgs.msg import JobStates, MissionEvent, MissionStatus, Plan, RobotState, TaskEvent
 from fjsp_planner.execution.tracking import relaxed_distances
 from fjsp_planner.faults import inject_fault
@@ -395,22 +396,21 @@ def fjsp_fleet(tmp_path):
 
 # --- what the robots did, from their events ----------------------------------------------
 
-def restart_revisions(plans) -> dict[str, int]:
-    """Per job, the last plan revision that (re)started it: its reports under older ones are
-    void (`PlanTask.continued`, `PlanTask.restarted_in`)."""
-    since = {}
+def restarts_in(plans) -> Restarts:
+    """Per job, the last plan revision of `plans` that (re)started it: its reports under
+    older ones are void (`PlanTask.continued`, `PlanTask.restarted_in`)."""
+    restarts = Restarts()
     for plan in plans:
-        for robot in plan.robots:
-            for task in robot.tasks:
-                attempt = plan.revision if not task.continued else task.restarted_in
-                since[task.job] = max(since.get(task.job, 0), attempt)
-    return since
+        tasks = (task for robot in plan.robots for task in robot.tasks)
+        for job, since in plan_attempts(plan.revision, tasks).items():
+            restarts.restart(job, since)
+    return restarts
 
 
 def valid_events(plans, events) -> list[TaskEvent]:
     """The events of each job's last attempt, the one that counts."""
-    since = restart_revisions(plans)
-    return [e for e in events if e.plan_revision >= since.get(e.job, 0)]
+    restarts = restarts_in(plans)
+    return [e for e in events if not restarts.void(e.job, e.plan_revision)]
 
 
 def executed_timeline(problem: Problem, plans, events) -> Schedule:

@@ -42,6 +42,7 @@ from fjsp_common.diagnostics import (
     diagnostic_array,
     robot_diagnostic,
 )
+from fjsp_common.revisions import plan_attempts
 from fjsp_common.running import ParameterError, declare, run_node, shorten
 from fjsp_common.vocabulary import EventKind, RobotMode
 from fjsp_msgs.msg import Plan, RobotState, TaskEvent
@@ -171,12 +172,11 @@ class RobotAgent(Node):
         if self.time_scale and self.time_scale != msg.time_scale:
             log.warning(f'running at time_scale {self.time_scale} s/unit while the plan '
                         f'assumes {msg.time_scale}: this robot runs off the planned pace')
-        job_robots, restarted_in = {}, {}
+        job_robots = {}
         for robot_plan in msg.robots:
             for t in robot_plan.tasks:
                 job_robots.setdefault(t.job, set()).add(robot_plan.robot)
-                since = t.restarted_in if t.continued else msg.revision
-                restarted_in[t.job] = max(restarted_in.get(t.job, 0), since)
+        restarted_in = plan_attempts(msg.revision, (t for r in msg.robots for t in r.tasks))
         tasks = [Task(job=t.job, operation_type=t.operation_type, location=t.location,
                       travel_start=t.travel_start, arrival=t.arrival, start=t.start,
                       operation_end=t.operation_end, end=t.end,

@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 from enum import StrEnum
 from fractions import Fraction
 
+from fjsp_common.revisions import void
 from fjsp_common.vocabulary import EventKind, RobotMode
 from fjsp_planner.execution.replan import ExecutionState, RobotState
 from fjsp_planner.model.limits import shown
@@ -224,7 +225,7 @@ class MissionTracker:
             return Outcome(Ignored.UNKNOWN, f'{what} follows plan revision '
                                             f'{revision}, which was never published '
                                             f'(current: {self.revision})')
-        if revision < self.jobs[job].since_revision:
+        if void(revision, self.jobs[job].since_revision):
             return Outcome(Ignored.STALE, f"{what} follows plan revision "
                                           f"{revision}; revision "
                                           f'{self.jobs[job].since_revision} started '

@@ -14,6 +14,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 
 from fjsp_common.clock import ScheduleClock, seconds
+from fjsp_common.revisions import attempt_revision
 from fjsp_common.vocabulary import EventKind, MissionEventKind, MissionState, RobotMode
 
 VOCABULARIES = {
@@ -52,7 +53,7 @@ class PlannedTask:
     def attempt_since(self, revision: int) -> int:
         """The revision whose attempt at the job this task, of plan `revision`, goes on with
         (0: unknown)."""
-        return revision if not self.continued else min(self.restarted_in, revision)
+        return attempt_revision(revision, self.continued, self.restarted_in)
 
 
 @dataclass(frozen=True)

@@ -7,6 +7,7 @@ for a recording: its last message) and returns JSON-ready dicts. Times are sched
 
 import math
 
+from fjsp_common.revisions import void
 from fjsp_common.vocabulary import EventKind, RobotMode
 from fjsp_planner.observe.history import FleetHistory, MissionHistory, Outcome
 from fjsp_planner.observe.story import story as told
@@ -133,7 +134,8 @@ def _arrived(mission: MissionHistory, job: str, revision: int) -> set[str]:
     restarted = max((t.attempt_since(r) for r, p in mission.plans.items() if r <= revision
                      for t in p.tasks if t.job == job), default=0)
     return {e.robot for e in mission.task_events.values()
-            if e.job == job and e.kind == EventKind.ARRIVED and e.revision >= restarted}
+            if e.job == job and e.kind == EventKind.ARRIVED
+            and not void(e.revision, restarted)}
 
 
 def timeline(fleet: FleetHistory, mission: MissionHistory, now: float) -> dict:
