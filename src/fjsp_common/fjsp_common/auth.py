@@ -30,8 +30,6 @@ from fjsp_msgs.msg import Auth
 KEY_BYTES = 32
 KEY_FILE_VARIABLE = 'FJSP_FLEET_KEY_FILE'
 """Where command-line tools and scripts find the fleet key when not told otherwise."""
-PLANNER = 'planner'
-"""The sender name of the fleet's planner: the only one whose plans and verdicts count."""
 
 
 class FleetKeyError(ValueError):

@@ -22,11 +22,6 @@ RUN_MISSION_ACTION = 'run_mission'
 ADD_JOBS_SERVICE = 'add_jobs'
 CANCEL_MISSION_SERVICE = 'cancel_mission'
 
-def agent_node_name(robot: str) -> str:
-    """The node of a robot's agent: one per robot, so no two nodes of a fleet share a name."""
-    return f'agent_{robot}'
-
-
 MAX_FLEET = 128
 """Robot states a late joiner catches up on: at least the largest fleet a scenario may have."""
 

@@ -48,17 +48,17 @@ from fjsp_common.contract import (
     ROBOT_STATES_TOPIC,
     TASK_EVENTS_TOPIC,
 )
+from fjsp_common.fleet import PLANNER_NODE, agent_node_name
 from fjsp_common.revisions import Restarts, plan_attempts
 from fjsp_msgs.msg import JobStates, MissionEvent, MissionStatus, Plan, RobotState, TaskEvent
 from fjsp_planner.execution.tracking import relaxed_distances
 from fjsp_planner.faults import inject_fault
 from fjsp_planner.launcher.hosts import HostsUnavailableError, Network
 from fjsp_planner.launcher.listener import Listener, environment
-from fjsp_planner.launcher.supervision import PLANNER_NODE, Fleet, find_executable
+from fjsp_planner.launcher.supervision import Fleet, find_executable
 from fjsp_planner.model.problem import Problem
 from fjsp_planner.model.schedule import JobAssignment, Schedule
 from fjsp_planner.model.validate import validate
-from robot_agents.agent_node import agent_node_name
 
 TEST_TIME_SCALE = 0.03
 """Wall seconds per schedule unit: the paper's 32-unit mission takes about a second."""

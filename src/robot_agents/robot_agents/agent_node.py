@@ -20,7 +20,7 @@ from rclpy.exceptions import InvalidServiceNameException
 from rclpy.node import Node
 from rclpy.time import Time as RosTime
 
-from fjsp_common.auth import PLANNER, NodeAuth
+from fjsp_common.auth import NodeAuth
 from fjsp_common.clock import ScheduleClock, seconds
 from fjsp_common.contract import (
     EVENT_FROM_MSG,
@@ -34,7 +34,6 @@ from fjsp_common.contract import (
     PLAN_TOPIC,
     ROBOT_STATES_TOPIC,
     TASK_EVENTS_TOPIC,
-    agent_node_name,
 )
 from fjsp_common.diagnostics import (
     DIAGNOSTICS_QOS,
@@ -42,6 +41,7 @@ from fjsp_common.diagnostics import (
     diagnostic_array,
     robot_diagnostic,
 )
+from fjsp_common.fleet import PLANNER_NODE, agent_node_name
 from fjsp_common.revisions import plan_attempts
 from fjsp_common.running import ParameterError, declare, run_node, shorten
 from fjsp_common.vocabulary import EventKind, RobotMode
@@ -139,7 +139,7 @@ class RobotAgent(Node):
     # --- plans -------------------------------------------------------------------------
 
     def on_plan(self, msg: Plan) -> None:
-        if not self.auth.accept(msg, PLAN_TOPIC, {PLANNER}):
+        if not self.auth.accept(msg, PLAN_TOPIC, {PLANNER_NODE}):
             return
         log = self.get_logger()
         mission = shorten(msg.mission_id, 80)
@@ -238,7 +238,7 @@ class RobotAgent(Node):
     # --- what the others report --------------------------------------------------------
 
     def on_event(self, msg: TaskEvent) -> None:
-        senders = {PLANNER} if msg.kind == TaskEvent.KIND_JOB_DONE else {msg.robot}
+        senders = {PLANNER_NODE} if msg.kind == TaskEvent.KIND_JOB_DONE else {msg.robot}
         if not self.auth.accept(msg, TASK_EVENTS_TOPIC, senders):
             return
         if msg.mission_id != self.mission_id:

@@ -18,7 +18,7 @@ from pathlib import Path
 from diagnostic_msgs.msg import DiagnosticArray
 from rclpy.node import Node
 
-from fjsp_common.auth import PLANNER, NodeAuth
+from fjsp_common.auth import NodeAuth
 from fjsp_common.contract import (
     EVENTS_QOS,
     LATCHED_QOS,
@@ -35,6 +35,7 @@ from fjsp_common.diagnostics import (
     diagnostic_array,
     robot_diagnostic,
 )
+from fjsp_common.fleet import MONITOR_NODE, PLANNER_NODE
 from fjsp_common.running import declare, run_node, shorten
 from fjsp_common.vocabulary import RobotMode
 from fjsp_msgs.msg import MissionEvent, MissionStatus, Plan, RobotState, TaskEvent
@@ -56,12 +57,12 @@ def senders_of(msg) -> set[str]:
         return {msg.robot}
     if isinstance(msg, TaskEvent) and msg.kind != TaskEvent.KIND_JOB_DONE:
         return {msg.robot}
-    return {PLANNER}
+    return {PLANNER_NODE}
 
 
 class MonitorNode(Node):
     def __init__(self):
-        super().__init__('monitor')
+        super().__init__(MONITOR_NODE)
         out_dir = declare(self, 'out_dir', '',
                           "directory of the Gantt charts and histories; empty: the workspace's "
                           'out/ (else ~/.ros/fjsp/out)')
@@ -116,7 +117,7 @@ class MonitorNode(Node):
                     f'no live web page: cannot serve on {web_host}:{web_port} '
                     f'({error.strerror or error}); set web_port to a free port, or 0')
 
-        self.auth = NodeAuth(self, 'monitor')
+        self.auth = NodeAuth(self, MONITOR_NODE)
         for msg_type, topic, qos in ((Plan, PLAN_TOPIC, LATCHED_QOS),
                                      (RobotState, ROBOT_STATES_TOPIC, ROBOT_STATES_QOS),
                                      (TaskEvent, TASK_EVENTS_TOPIC, EVENTS_QOS),
@@ -267,4 +268,4 @@ class MonitorNode(Node):
 
 
 def main(args=None):
-    sys.exit(run_node(MonitorNode, 'monitor', args, done=lambda node: node.finished))
+    sys.exit(run_node(MonitorNode, MONITOR_NODE, args, done=lambda node: node.finished))

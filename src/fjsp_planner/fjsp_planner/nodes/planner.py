@@ -25,7 +25,7 @@ from rclpy.serialization import deserialize_message, serialize_message
 from rclpy.task import Future as RosFuture
 from rclpy.time import Time
 
-from fjsp_common.auth import PLANNER, NodeAuth
+from fjsp_common.auth import NodeAuth
 from fjsp_common.contract import (
     ADD_JOBS_SERVICE,
     CANCEL_MISSION_SERVICE,
@@ -50,6 +50,7 @@ from fjsp_common.diagnostics import (
     diagnostic_array,
     planner_diagnostic,
 )
+from fjsp_common.fleet import DIAGNOSTICS_PERIOD, PLANNER_NODE
 from fjsp_common.running import ParameterError, declare, run_node, shorten
 from fjsp_common.vocabulary import MissionEventKind, MissionState
 from fjsp_msgs.action import RunMission
@@ -157,7 +158,7 @@ def describe(note: Note) -> str:
 
 class PlannerNode(Node):
     def __init__(self):
-        super().__init__('planner')
+        super().__init__(PLANNER_NODE)
         scenario = declare(self, 'scenario', '',
                            'scenario file of a mission to run at start-up; empty: wait for '
                            'RunMission goals')
@@ -212,7 +213,7 @@ class PlannerNode(Node):
                                      + '\n'.join(problems)) from None
             origin = origin_of(text, panels, shift)
 
-        self.auth = NodeAuth(self, PLANNER)
+        self.auth = NodeAuth(self, PLANNER_NODE)
         self.controller = MissionController(self.settings())
         self.journal: Journal | None = None
         self.goal: Goal | None = None
@@ -253,7 +254,7 @@ class PlannerNode(Node):
                                                      DIAGNOSTICS_QOS)
         self.create_timer(0.1, self.tick)
         self.create_timer(status_period, self.publish_periodic)
-        self.create_timer(1.0, self.publish_diagnostics)
+        self.create_timer(DIAGNOSTICS_PERIOD, self.publish_diagnostics)
         ActionServer(self, RunMission, RUN_MISSION_ACTION, self.execute_goal,
                      goal_callback=lambda _: GoalResponse.ACCEPT,
                      cancel_callback=self.cancel_goal)
@@ -586,7 +587,7 @@ class PlannerNode(Node):
     def on_event(self, msg: TaskEvent) -> None:
         if msg.kind == TaskEvent.KIND_JOB_DONE and msg.event_id in self.job_done_ids:
             return  # its own
-        senders = {PLANNER} if msg.kind == TaskEvent.KIND_JOB_DONE else {msg.robot}
+        senders = {PLANNER_NODE} if msg.kind == TaskEvent.KIND_JOB_DONE else {msg.robot}
         if not self.auth.accept(msg, TASK_EVENTS_TOPIC, senders):
             return
         kind = EVENT_FROM_MSG.get(msg.kind)
@@ -605,7 +606,7 @@ class PlannerNode(Node):
     def on_plan(self, msg: Plan) -> None:
         if (msg.mission_id, msg.revision, msg.stamp) == self.last_published:
             return
-        if not self.auth.accept(msg, PLAN_TOPIC, {PLANNER}):
+        if not self.auth.accept(msg, PLAN_TOPIC, {PLANNER_NODE}):
             return
         current = self.controller.mission
         revision = current.tracker.revision if current is not None else 0
@@ -874,4 +875,4 @@ def write_plan_file(path: Path, msg: Plan) -> None:
 
 
 def main(args=None):
-    sys.exit(run_node(PlannerNode, 'planner', args))
+    sys.exit(run_node(PlannerNode, PLANNER_NODE, args))

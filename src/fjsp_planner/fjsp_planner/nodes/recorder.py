@@ -30,6 +30,7 @@ from fjsp_common.contract import (
     TASK_EVENTS_TOPIC,
 )
 from fjsp_common.diagnostics import DIAGNOSTICS_QOS, DIAGNOSTICS_TOPIC
+from fjsp_common.fleet import RECORDER_NODE
 from fjsp_common.running import ParameterError, declare, run_node
 from fjsp_msgs.msg import JobStates, MissionEvent, MissionStatus, Plan, RobotState, TaskEvent
 from fjsp_planner.observe.recording import (
@@ -68,7 +69,7 @@ def installed_msg(package: str, name: str) -> str:
 
 class RecorderNode(Node):
     def __init__(self):
-        super().__init__('recorder')
+        super().__init__(RECORDER_NODE)
         out_dir = declare(self, 'out_dir', '',
                           "directory of the recording; empty: the workspace's out/ (else "
                           '~/.ros/fjsp/out)')
@@ -147,4 +148,4 @@ class RecorderNode(Node):
 
 
 def main(args=None):
-    sys.exit(run_node(RecorderNode, 'recorder', args))
+    sys.exit(run_node(RecorderNode, RECORDER_NODE, args))

@@ -32,6 +32,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from enum import StrEnum
 
+from fjsp_common.fleet import HEARTBEAT_TIMEOUT
 from fjsp_common.vocabulary import EventKind, MissionEventKind, MissionState, RobotMode
 from fjsp_planner.observe.facts import (
     Fact,
@@ -506,7 +507,7 @@ class MissionHistory:
 class FleetHistory:
     """Every mission seen on one fleet (by mission id), and each robot's latest state."""
 
-    def __init__(self, heartbeat_timeout: float = 1.0):
+    def __init__(self, heartbeat_timeout: float = HEARTBEAT_TIMEOUT):
         self.heartbeat_timeout = heartbeat_timeout
         self.missions: dict[str, MissionHistory] = {}
         self.robots: dict[str, RobotStateFact] = {}

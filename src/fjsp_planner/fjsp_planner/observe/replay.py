@@ -11,6 +11,7 @@ import argparse
 import sys
 from pathlib import Path
 
+from fjsp_common.fleet import HEARTBEAT_TIMEOUT
 from fjsp_planner.observe import text, views
 from fjsp_planner.observe.mission_chart import write_mission
 from fjsp_planner.observe.recording import RecordingError, replay
@@ -36,9 +37,9 @@ def parse(argv):
                         help="directory of the charts (default: the recording's)")
     parser.add_argument('--mission', default='',
                         help='only this mission id (default: every mission recorded)')
-    parser.add_argument('--heartbeat-timeout', type=positive, default=1.0,
+    parser.add_argument('--heartbeat-timeout', type=positive, default=HEARTBEAT_TIMEOUT,
                         help='seconds without a robot state that count as offline '
-                        '(default 1.0, as the nodes)')
+                        f'(default {HEARTBEAT_TIMEOUT}, as the nodes)')
     parser.add_argument('--no-chart', action='store_true', help='print only, draw nothing')
     return parser.parse_args(argv)
 
