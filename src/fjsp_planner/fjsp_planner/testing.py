@@ -38,15 +38,12 @@ import pytest
 
 from fjsp_common.clock import ScheduleClock, seconds
 from fjsp_common.contract import (
-    EVENTS_QOS,
-    JOB_STATES_TOPIC,
-    LATCHED_QOS,
-    MISSION_EVENTS_TOPIC,
-    MISSION_STATUS_TOPIC,
-    PLAN_TOPIC,
-    ROBOT_STATES_QOS,
-    ROBOT_STATES_TOPIC,
-    TASK_EVENTS_TOPIC,
+    JOB_STATES,
+    MISSION_EVENTS,
+    MISSION_STATUS,
+    PLAN,
+    ROBOT_STATES,
+    TASK_EVENTS,
 )
 from fjsp_common.fleet import PLANNER_NODE, agent_node_name
 from fjsp_common.revisions import Restarts, plan_attempts
@@ -125,15 +122,12 @@ class Observer(Listener):
         self.robots: dict[str, RobotState] = {}
         """Latest state of each robot."""
         self.robot_history: list[RobotState] = []
-        self.subscribe(Plan, PLAN_TOPIC, LATCHED_QOS, self.plans.append)
-        self.subscribe(TaskEvent, TASK_EVENTS_TOPIC, EVENTS_QOS, self.events.append)
-        self.subscribe(MissionEvent, MISSION_EVENTS_TOPIC, EVENTS_QOS,
-                       self.mission_events.append)
-        self.subscribe(MissionStatus, MISSION_STATUS_TOPIC, LATCHED_QOS,
-                       lambda msg: setattr(self, 'status', msg))
-        self.subscribe(JobStates, JOB_STATES_TOPIC, LATCHED_QOS,
-                       lambda msg: setattr(self, 'job_states', msg))
-        self.subscribe(RobotState, ROBOT_STATES_TOPIC, ROBOT_STATES_QOS, self._robot)
+        for topic, callback in ((PLAN, self.plans.append), (TASK_EVENTS, self.events.append),
+                                (MISSION_EVENTS, self.mission_events.append),
+                                (MISSION_STATUS, lambda msg: setattr(self, 'status', msg)),
+                                (JOB_STATES, lambda msg: setattr(self, 'job_states', msg)),
+                                (ROBOT_STATES, self._robot)):
+            self.subscribe(topic.type, topic.name, topic.qos, callback)
 
     def _robot(self, msg: RobotState) -> None:
         self.robots[msg.robot] = msg

@@ -15,7 +15,6 @@ import sys
 from collections import deque
 from pathlib import Path
 
-from diagnostic_msgs.msg import DiagnosticArray
 from rclpy.exceptions import InvalidServiceNameException
 from rclpy.node import Node
 from rclpy.time import Time as RosTime
@@ -23,24 +22,23 @@ from rclpy.time import Time as RosTime
 from fjsp_common.auth import NodeAuth
 from fjsp_common.clock import ScheduleClock, seconds
 from fjsp_common.contract import (
+    DIAGNOSTICS,
     EVENT_FROM_MSG,
     EVENT_HISTORY,
     EVENT_TO_MSG,
-    EVENTS_QOS,
     FAULT_REQUESTS_QOS,
     INJECT_FAULT_SERVICE,
-    LATCHED_QOS,
     MODE_TO_MSG,
+    PLAN,
     PLAN_TOPIC,
+    ROBOT_STATES,
     ROBOT_STATES_TOPIC,
+    TASK_EVENTS,
     TASK_EVENTS_TOPIC,
+    publisher,
+    subscription,
 )
-from fjsp_common.diagnostics import (
-    DIAGNOSTICS_QOS,
-    DIAGNOSTICS_TOPIC,
-    diagnostic_array,
-    robot_diagnostic,
-)
+from fjsp_common.diagnostics import diagnostic_array, robot_diagnostic
 from fjsp_common.fleet import PLANNER_NODE, agent_node_name
 from fjsp_common.revisions import plan_attempts
 from fjsp_common.running import ParameterError, declare, run_node, shorten
@@ -109,10 +107,10 @@ class RobotAgent(Node):
         self.early_events: deque[TaskEvent] = deque(maxlen=EVENT_HISTORY)
         """Reports of a mission this robot does not follow (yet): its plan may come later."""
 
-        self.state_pub = self.create_publisher(RobotState, ROBOT_STATES_TOPIC, LATCHED_QOS)
-        self.event_pub = self.create_publisher(TaskEvent, TASK_EVENTS_TOPIC, EVENTS_QOS)
-        self.create_subscription(Plan, PLAN_TOPIC, self.on_plan, LATCHED_QOS)
-        self.create_subscription(TaskEvent, TASK_EVENTS_TOPIC, self.on_event, EVENTS_QOS)
+        self.state_pub = publisher(self, ROBOT_STATES)
+        self.event_pub = publisher(self, TASK_EVENTS)
+        subscription(self, PLAN, self.on_plan)
+        subscription(self, TASK_EVENTS, self.on_event)
         self.fault_service = f'{self.robot}/{INJECT_FAULT_SERVICE}'
         try:
             self.create_service(InjectFault, self.fault_service, self.on_fault,
@@ -120,8 +118,7 @@ class RobotAgent(Node):
         except InvalidServiceNameException:
             raise ParameterError(f"parameter 'robot_name' must be usable in a ROS name "
                                  f'(letters, digits, underscores), got {self.robot!r}') from None
-        self.diagnostics_pub = self.create_publisher(DiagnosticArray, DIAGNOSTICS_TOPIC,
-                                                     DIAGNOSTICS_QOS)
+        self.diagnostics_pub = publisher(self, DIAGNOSTICS)
         self.create_timer(tick_period, self.tick)
         self.create_timer(heartbeat_period, self.publish_state)
         self.create_timer(diagnostics_period, self.publish_diagnostics)

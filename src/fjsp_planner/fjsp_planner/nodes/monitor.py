@@ -15,30 +15,24 @@ import sys
 import time
 from pathlib import Path
 
-from diagnostic_msgs.msg import DiagnosticArray
 from rclpy.node import Node
 
 from fjsp_common.auth import NodeAuth
 from fjsp_common.contract import (
-    EVENTS_QOS,
-    LATCHED_QOS,
-    MISSION_EVENTS_TOPIC,
-    MISSION_STATUS_TOPIC,
-    PLAN_TOPIC,
-    ROBOT_STATES_QOS,
-    ROBOT_STATES_TOPIC,
-    TASK_EVENTS_TOPIC,
+    DIAGNOSTICS,
+    MISSION_EVENTS,
+    MISSION_STATUS,
+    PLAN,
+    ROBOT_STATES,
+    TASK_EVENTS,
+    publisher,
+    subscription,
 )
-from fjsp_common.diagnostics import (
-    DIAGNOSTICS_QOS,
-    DIAGNOSTICS_TOPIC,
-    diagnostic_array,
-    robot_diagnostic,
-)
+from fjsp_common.diagnostics import diagnostic_array, robot_diagnostic
 from fjsp_common.fleet import MONITOR_NODE, PLANNER_NODE
 from fjsp_common.running import declare, run_node, shorten
 from fjsp_common.vocabulary import RobotMode
-from fjsp_msgs.msg import MissionEvent, MissionStatus, Plan, RobotState, TaskEvent
+from fjsp_msgs.msg import MissionEvent, MissionStatus, RobotState, TaskEvent
 from fjsp_planner.observe import text, views
 from fjsp_planner.observe.dashboard import Dashboard
 from fjsp_planner.observe.facts import Decoder, UnreadableMessageError
@@ -118,15 +112,9 @@ class MonitorNode(Node):
                     f'({error.strerror or error}); set web_port to a free port, or 0')
 
         self.auth = NodeAuth(self, MONITOR_NODE)
-        for msg_type, topic, qos in ((Plan, PLAN_TOPIC, LATCHED_QOS),
-                                     (RobotState, ROBOT_STATES_TOPIC, ROBOT_STATES_QOS),
-                                     (TaskEvent, TASK_EVENTS_TOPIC, EVENTS_QOS),
-                                     (MissionEvent, MISSION_EVENTS_TOPIC, EVENTS_QOS),
-                                     (MissionStatus, MISSION_STATUS_TOPIC, LATCHED_QOS)):
-            self.create_subscription(msg_type, topic, self.receiver(msg_type.__name__, topic),
-                                     qos)
-        self.diagnostics_pub = self.create_publisher(DiagnosticArray, DIAGNOSTICS_TOPIC,
-                                                     DIAGNOSTICS_QOS)
+        for topic in (PLAN, ROBOT_STATES, TASK_EVENTS, MISSION_EVENTS, MISSION_STATUS):
+            subscription(self, topic, self.receiver(topic.type.__name__, topic.name))
+        self.diagnostics_pub = publisher(self, DIAGNOSTICS)
         self.create_timer(refresh_period, self.refresh)
         self.create_timer(diagnostics_period, self.publish_diagnostics)
         if self.dashboard is not None:

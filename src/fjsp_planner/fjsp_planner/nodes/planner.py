@@ -18,7 +18,6 @@ from concurrent.futures import Future, ThreadPoolExecutor
 from datetime import UTC, datetime
 from pathlib import Path
 
-from diagnostic_msgs.msg import DiagnosticArray
 from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.node import Node
 from rclpy.serialization import deserialize_message, serialize_message
@@ -29,27 +28,28 @@ from fjsp_common.auth import NodeAuth
 from fjsp_common.contract import (
     ADD_JOBS_SERVICE,
     CANCEL_MISSION_SERVICE,
+    DIAGNOSTICS,
     EVENT_FROM_MSG,
-    EVENTS_QOS,
+    JOB_STATES,
     JOB_STATES_TOPIC,
-    LATCHED_QOS,
     MISSION_EVENT_TO_MSG,
+    MISSION_EVENTS,
     MISSION_EVENTS_TOPIC,
+    MISSION_STATUS,
     MISSION_STATUS_TOPIC,
     MODE_FROM_MSG,
+    PLAN,
     PLAN_TOPIC,
-    ROBOT_STATES_QOS,
+    ROBOT_STATES,
     ROBOT_STATES_TOPIC,
     RUN_MISSION_ACTION,
     STATE_TO_MSG,
+    TASK_EVENTS,
     TASK_EVENTS_TOPIC,
+    publisher,
+    subscription,
 )
-from fjsp_common.diagnostics import (
-    DIAGNOSTICS_QOS,
-    DIAGNOSTICS_TOPIC,
-    diagnostic_array,
-    planner_diagnostic,
-)
+from fjsp_common.diagnostics import diagnostic_array, planner_diagnostic
 from fjsp_common.fleet import DIAGNOSTICS_PERIOD, PLANNER_NODE
 from fjsp_common.running import ParameterError, declare, run_node, shorten
 from fjsp_common.vocabulary import MissionEventKind, MissionState
@@ -241,17 +241,15 @@ class PlannerNode(Node):
         """Set under `waking` once the node is being destroyed: a solve ending then has no
         guard condition left to trigger."""
 
-        self.plan_pub = self.create_publisher(Plan, PLAN_TOPIC, LATCHED_QOS)
-        self.status_pub = self.create_publisher(MissionStatus, MISSION_STATUS_TOPIC, LATCHED_QOS)
-        self.jobs_pub = self.create_publisher(JobStates, JOB_STATES_TOPIC, LATCHED_QOS)
-        self.event_pub = self.create_publisher(TaskEvent, TASK_EVENTS_TOPIC, EVENTS_QOS)
-        self.story_pub = self.create_publisher(MissionEvent, MISSION_EVENTS_TOPIC, EVENTS_QOS)
-        self.create_subscription(RobotState, ROBOT_STATES_TOPIC, self.on_robot_state,
-                                 ROBOT_STATES_QOS)
-        self.create_subscription(TaskEvent, TASK_EVENTS_TOPIC, self.on_event, EVENTS_QOS)
-        self.create_subscription(Plan, PLAN_TOPIC, self.on_plan, LATCHED_QOS)
-        self.diagnostics_pub = self.create_publisher(DiagnosticArray, DIAGNOSTICS_TOPIC,
-                                                     DIAGNOSTICS_QOS)
+        self.plan_pub = publisher(self, PLAN)
+        self.status_pub = publisher(self, MISSION_STATUS)
+        self.jobs_pub = publisher(self, JOB_STATES)
+        self.event_pub = publisher(self, TASK_EVENTS)
+        self.story_pub = publisher(self, MISSION_EVENTS)
+        subscription(self, ROBOT_STATES, self.on_robot_state)
+        subscription(self, TASK_EVENTS, self.on_event)
+        subscription(self, PLAN, self.on_plan)
+        self.diagnostics_pub = publisher(self, DIAGNOSTICS)
         self.create_timer(0.1, self.tick)
         self.create_timer(status_period, self.publish_periodic)
         self.create_timer(DIAGNOSTICS_PERIOD, self.publish_diagnostics)
@@ -745,7 +743,7 @@ class PlannerNode(Node):
         # A subscription that has not matched the writer in seconds may never match it; a new
         # writer is announced to every subscription afresh.
         self.destroy_publisher(self.plan_pub)
-        self.plan_pub = self.create_publisher(Plan, PLAN_TOPIC, LATCHED_QOS)
+        self.plan_pub = publisher(self, PLAN)
         self.plan_pub.publish(self.auth.sign(msg, PLAN_TOPIC))
         self.get_logger().warning(f'published plan revision {msg.revision} again, on a new '
                                   'writer')

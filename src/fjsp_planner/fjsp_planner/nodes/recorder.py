@@ -14,25 +14,12 @@ from datetime import UTC, datetime
 from pathlib import Path
 
 from ament_index_python.packages import PackageNotFoundError, get_package_share_directory
-from diagnostic_msgs.msg import DiagnosticArray
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, ReliabilityPolicy
 
-from fjsp_common.contract import (
-    EVENTS_QOS,
-    JOB_STATES_TOPIC,
-    LATCHED_QOS,
-    MISSION_EVENTS_TOPIC,
-    MISSION_STATUS_TOPIC,
-    PLAN_TOPIC,
-    ROBOT_STATES_QOS,
-    ROBOT_STATES_TOPIC,
-    TASK_EVENTS_TOPIC,
-)
-from fjsp_common.diagnostics import DIAGNOSTICS_QOS, DIAGNOSTICS_TOPIC
+from fjsp_common.contract import TOPICS, subscription
 from fjsp_common.fleet import RECORDER_NODE
 from fjsp_common.running import ParameterError, declare, run_node
-from fjsp_msgs.msg import JobStates, MissionEvent, MissionStatus, Plan, RobotState, TaskEvent
 from fjsp_planner.observe.recording import (
     COMPRESSIONS,
     Offer,
@@ -41,15 +28,6 @@ from fjsp_planner.observe.recording import (
     message_definition,
 )
 from fjsp_planner.workspace import default_out_dir
-
-TOPICS = ((PLAN_TOPIC, Plan, LATCHED_QOS),
-          (ROBOT_STATES_TOPIC, RobotState, ROBOT_STATES_QOS),
-          (TASK_EVENTS_TOPIC, TaskEvent, EVENTS_QOS),
-          (MISSION_EVENTS_TOPIC, MissionEvent, EVENTS_QOS),
-          (MISSION_STATUS_TOPIC, MissionStatus, LATCHED_QOS),
-          (JOB_STATES_TOPIC, JobStates, LATCHED_QOS),
-          (DIAGNOSTICS_TOPIC, DiagnosticArray, DIAGNOSTICS_QOS))
-"""Every topic of a mission: (name, type, the QoS its publishers offer)."""
 
 
 def type_name(msg_type) -> str:
@@ -97,15 +75,16 @@ class RecorderNode(Node):
                                  f'{error.strerror or error}') from None
         self.failed = False
         try:
-            for topic, msg_type, qos in TOPICS:
+            for topic in TOPICS:
+                # The QoS its readers use: a replay's one writer stands for all the fleet's.
+                qos = topic.qos
                 channel = self.writer.add_topic(
-                    self.resolve_topic_name(topic), type_name(msg_type),
-                    message_definition(type_name(msg_type), installed_msg),
+                    self.resolve_topic_name(topic.name), type_name(topic.type),
+                    message_definition(type_name(topic.type), installed_msg),
                     Offer(reliable=qos.reliability == ReliabilityPolicy.RELIABLE,
                           transient_local=qos.durability == DurabilityPolicy.TRANSIENT_LOCAL,
                           depth=qos.depth))
-                self.create_subscription(msg_type, topic, self.recording(channel), qos,
-                                         raw=True)
+                subscription(self, topic, self.recording(channel), raw=True)
         except RecordingError as error:
             self.writer.close()
             raise ParameterError(f'cannot record: {error}') from None
