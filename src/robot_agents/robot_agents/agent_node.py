@@ -13,6 +13,7 @@ through `<robot_name>/inject_fault` (`fjsp_planner.faults`).
 
 import sys
 from collections import deque
+from dataclasses import replace
 from pathlib import Path
 
 from rclpy.exceptions import InvalidServiceNameException
@@ -39,7 +40,14 @@ from fjsp_common.contract import (
     subscription,
 )
 from fjsp_common.diagnostics import diagnostic_array, robot_diagnostic
-from fjsp_common.fleet import PLANNER_NODE, agent_node_name
+from fjsp_common.fleet import (
+    DIAGNOSTICS_PERIOD,
+    HEARTBEAT_PERIOD,
+    LATE_THRESHOLD,
+    PLANNER_NODE,
+    agent_node_name,
+)
+from fjsp_common.parameters import ParameterSpec, table
 from fjsp_common.revisions import plan_attempts
 from fjsp_common.running import ParameterError, declare, run_node, shorten
 from fjsp_common.vocabulary import EventKind, RobotMode
@@ -52,36 +60,42 @@ ANSWERS_KEPT = 1024
 NAME_LOOKUP_NODE = 'robot_agent'
 """The short-lived node that reads `robot_name` before the agent's own node can be named."""
 
+ROBOT_NAME = ParameterSpec('robot_name', '',
+                           'name of the robot this agent plays, as the scenario lists it')
+ROBOT_TYPE = ParameterSpec('robot_type', '', 'robot type this agent must play; empty: whatever '
+                           'type the plan gives it')
+PARAMETERS = table(
+    ROBOT_NAME,
+    ROBOT_TYPE,
+    ParameterSpec('time_scale', 0.0, "wall seconds per schedule unit; 0: the plan's", low=0.0,
+                  high=1000.0),
+    ParameterSpec('tick_period', 0.01, 'seconds between steps of the simulated execution',
+                  low=0.001, high=1.0),
+    ParameterSpec('heartbeat_period', HEARTBEAT_PERIOD,
+                  'seconds between robot states published as heartbeat', low=0.01, high=10.0),
+    ParameterSpec('diagnostics_period', DIAGNOSTICS_PERIOD,
+                  'seconds between health reports on /diagnostics', low=0.1, high=60.0),
+    ParameterSpec('late_threshold', LATE_THRESHOLD, 'schedule units an operation may run past '
+                  'its plan before the robot reports WARN', low=0.0, high=1e6),
+    ParameterSpec('reports_dir', '', 'directory where the agent keeps its reports, so that a '
+                  'planner resuming a mission learns what this robot did before its agent '
+                  'restarted; empty: not kept'),
+)
+"""The agent's parameters, in the order it declares them; the agent's executable gives
+`robot_name` (read first, to name the node) and `robot_type` (pinned by the per-type aliases)
+their defaults."""
+
 
 class RobotAgent(Node):
     def __init__(self, robot: str, pinned_type: str = ''):
         super().__init__(agent_node_name(robot))
-        self.robot = declare(self, 'robot_name', robot,
-                             'name of the robot this agent plays, as the scenario lists it')
-        self.pinned_type = declare(
-            self, 'robot_type', pinned_type,
-            'robot type this agent must play; empty: whatever type the plan gives it') \
-            or pinned_type
-        self.time_scale = declare(
-            self, 'time_scale', 0.0, "wall seconds per schedule unit; 0: the plan's",
-            low=0.0, high=1000.0)
-        tick_period = declare(self, 'tick_period', 0.01,
-                              'seconds between steps of the simulated execution',
-                              low=0.001, high=1.0)
-        heartbeat_period = declare(self, 'heartbeat_period', 0.2,
-                                   'seconds between robot states published as heartbeat',
-                                   low=0.01, high=10.0)
-        diagnostics_period = declare(self, 'diagnostics_period', 1.0,
-                                     'seconds between health reports on /diagnostics',
-                                     low=0.1, high=60.0)
-        self.late_threshold = declare(
-            self, 'late_threshold', 2.0,
-            'schedule units an operation may run past its plan before the robot reports WARN',
-            low=0.0, high=1e6)
-        reports_dir = declare(
-            self, 'reports_dir', '',
-            'directory where the agent keeps its reports, so that a planner resuming a '
-            'mission learns what this robot did before its agent restarted; empty: not kept')
+        given = {ROBOT_NAME.name: robot, ROBOT_TYPE.name: pinned_type}
+        value = {name: declare(self, replace(spec, default=given.get(name, spec.default)))
+                 for name, spec in PARAMETERS.items()}
+        self.robot = value['robot_name']
+        self.pinned_type = value['robot_type'] or pinned_type
+        self.time_scale = value['time_scale']
+        self.late_threshold = value['late_threshold']
         if pinned_type and self.pinned_type != pinned_type:
             raise ParameterError(f"parameter 'robot_type': this executable plays a "
                                  f"'{pinned_type}', got '{self.pinned_type}' (use robot_agent "
@@ -119,9 +133,10 @@ class RobotAgent(Node):
             raise ParameterError(f"parameter 'robot_name' must be usable in a ROS name "
                                  f'(letters, digits, underscores), got {self.robot!r}') from None
         self.diagnostics_pub = publisher(self, DIAGNOSTICS)
-        self.create_timer(tick_period, self.tick)
-        self.create_timer(heartbeat_period, self.publish_state)
-        self.create_timer(diagnostics_period, self.publish_diagnostics)
+        self.create_timer(value['tick_period'], self.tick)
+        self.create_timer(value['heartbeat_period'], self.publish_state)
+        self.create_timer(value['diagnostics_period'], self.publish_diagnostics)
+        reports_dir = value['reports_dir']
         self.reports = self.open_reports(reports_dir) if reports_dir else None
         self.publish_state()
         kind = f"a '{self.pinned_type}'" if self.pinned_type else 'any type'
@@ -420,8 +435,7 @@ def robot_name_from_parameters() -> str:
     probe = Node(NAME_LOOKUP_NODE, start_parameter_services=False,
                  enable_rosout=False)
     try:
-        robot = declare(probe, 'robot_name', '',
-                        'name of the robot this agent plays, as the scenario lists it')
+        robot = declare(probe, ROBOT_NAME)
     finally:
         probe.destroy_node()
     if not robot:

@@ -29,7 +29,14 @@ from fjsp_common.contract import (
     subscription,
 )
 from fjsp_common.diagnostics import diagnostic_array, robot_diagnostic
-from fjsp_common.fleet import MONITOR_NODE, PLANNER_NODE
+from fjsp_common.fleet import (
+    DIAGNOSTICS_PERIOD,
+    HEARTBEAT_TIMEOUT,
+    LATE_THRESHOLD,
+    MONITOR_NODE,
+    PLANNER_NODE,
+)
+from fjsp_common.parameters import ParameterSpec, table
 from fjsp_common.running import declare, run_node, shorten
 from fjsp_common.vocabulary import RobotMode
 from fjsp_msgs.msg import MissionEvent, MissionStatus, RobotState, TaskEvent
@@ -44,6 +51,31 @@ DECODER = Decoder.from_classes(RobotState, TaskEvent, MissionStatus, MissionEven
 TIMELINE_PERIOD = 1.0
 """Seconds between page updates when only the clock moved (offline robots, the timeline)."""
 
+PARAMETERS = table(
+    ParameterSpec('out_dir', '', "directory of the Gantt charts and histories; empty: the "
+                  "workspace's out/ (else ~/.ros/fjsp/out)"),
+    ParameterSpec('refresh_period', 1.0, 'seconds between checks for a new frame of the log '
+                  'view', low=0.05, high=60.0),
+    ParameterSpec('heartbeat_timeout', HEARTBEAT_TIMEOUT,
+                  'seconds without a robot state before the robot shows offline', low=0.05,
+                  high=600.0),
+    ParameterSpec('exit_on_complete', False, 'exit once a mission has ended and is drawn'),
+    # Events may reach a late joiner after the status saying the mission ended.
+    ParameterSpec('event_grace', 3.0, 'seconds to wait for late events once a mission ended '
+                  'before drawing it', low=0.0, high=600.0),
+    ParameterSpec('web_port', 8080, 'port of the live web page; 0: no web page', low=0,
+                  high=65535),
+    ParameterSpec('web_host', '127.0.0.1',
+                  'address the web page is served on (0.0.0.0: every interface)'),
+    ParameterSpec('web_period', 0.1, 'seconds between checks for changes to push to the web '
+                  'page', low=0.02, high=10.0),
+    ParameterSpec('diagnostics_period', DIAGNOSTICS_PERIOD,
+                  'seconds between per-robot diagnostics on /diagnostics', low=0.1, high=60.0),
+    ParameterSpec('late_threshold', LATE_THRESHOLD, "schedule units a robot's operation may run "
+                  'past its plan before its diagnostic is WARN', low=0.0, high=1e6),
+)
+"""The monitor's parameters, in the order it declares them."""
+
 
 def senders_of(msg) -> set[str]:
     """Who may have signed `msg`: the robot it is about, or the planner."""
@@ -57,40 +89,15 @@ def senders_of(msg) -> set[str]:
 class MonitorNode(Node):
     def __init__(self):
         super().__init__(MONITOR_NODE)
-        out_dir = declare(self, 'out_dir', '',
-                          "directory of the Gantt charts and histories; empty: the workspace's "
-                          'out/ (else ~/.ros/fjsp/out)')
+        value = {name: declare(self, spec) for name, spec in PARAMETERS.items()}
+        out_dir = value['out_dir']
         self.out_dir = Path(out_dir).expanduser() if out_dir else default_out_dir()
-        refresh_period = declare(self, 'refresh_period', 1.0,
-                                 'seconds between checks for a new frame of the log view',
-                                 low=0.05, high=60.0)
-        heartbeat_timeout = declare(
-            self, 'heartbeat_timeout', 1.0,
-            'seconds without a robot state before the robot shows offline', low=0.05,
-            high=600.0)
-        self.exit_on_complete = declare(self, 'exit_on_complete', False,
-                                        'exit once a mission has ended and is drawn')
-        # Events may reach a late joiner after the status saying the mission ended.
-        self.event_grace = declare(
-            self, 'event_grace', 3.0,
-            'seconds to wait for late events once a mission ended before drawing it',
-            low=0.0, high=600.0)
-        web_port = declare(self, 'web_port', 8080,
-                           'port of the live web page; 0: no web page', low=0, high=65535)
-        web_host = declare(self, 'web_host', '127.0.0.1',
-                           'address the web page is served on (0.0.0.0: every interface)')
-        web_period = declare(self, 'web_period', 0.1,
-                             'seconds between checks for changes to push to the web page',
-                             low=0.02, high=10.0)
-        diagnostics_period = declare(
-            self, 'diagnostics_period', 1.0,
-            'seconds between per-robot diagnostics on /diagnostics', low=0.1, high=60.0)
-        self.late_threshold = declare(
-            self, 'late_threshold', 2.0,
-            "schedule units a robot's operation may run past its plan before its diagnostic "
-            'is WARN', low=0.0, high=1e6)
+        self.exit_on_complete = value['exit_on_complete']
+        self.event_grace = value['event_grace']
+        self.late_threshold = value['late_threshold']
+        web_port, web_host = value['web_port'], value['web_host']
 
-        self.fleet = FleetHistory(heartbeat_timeout)
+        self.fleet = FleetHistory(value['heartbeat_timeout'])
         self.told: set[tuple[str, str]] = set()
         """(mission, story key) of every line already logged."""
         self.frame_key = None
@@ -115,10 +122,10 @@ class MonitorNode(Node):
         for topic in (PLAN, ROBOT_STATES, TASK_EVENTS, MISSION_EVENTS, MISSION_STATUS):
             subscription(self, topic, self.receiver(topic.type.__name__, topic.name))
         self.diagnostics_pub = publisher(self, DIAGNOSTICS)
-        self.create_timer(refresh_period, self.refresh)
-        self.create_timer(diagnostics_period, self.publish_diagnostics)
+        self.create_timer(value['refresh_period'], self.refresh)
+        self.create_timer(value['diagnostics_period'], self.publish_diagnostics)
         if self.dashboard is not None:
-            self.create_timer(web_period, self.push_page)
+            self.create_timer(value['web_period'], self.push_page)
 
     def receiver(self, type_name: str, topic: str):
         def receive(msg) -> None:

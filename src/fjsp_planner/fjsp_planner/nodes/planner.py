@@ -76,22 +76,17 @@ from fjsp_planner.execution.mission.effects import (
     SolveKind,
 )
 from fjsp_planner.execution.mission.reports import EventReport, RobotReport
-from fjsp_planner.execution.mission.settings import Settings
+from fjsp_planner.execution.mission.settings import PARAMETERS, SETTINGS_PARAMETERS, Settings
 from fjsp_planner.execution.replan import improve, repair
 from fjsp_planner.execution.tracking import Ignored
 from fjsp_planner.model.extension import extend
 from fjsp_planner.model.problem import ProblemError
 from fjsp_planner.model.scenario import load_scenario, scenario_from_text
 from fjsp_planner.nodes.conversions import cancel_msg, job_states, plan_msg
-from fjsp_planner.solving.solve import SOLVERS, solve
+from fjsp_planner.solving.solve import solve
 
 ANSWERS_KEPT = 256
 """Answers kept per service for requests that are resent."""
-
-RUNTIME_PARAMETERS = ('time_limit', 'replan_time_limit', 'workers', 'heartbeat_timeout',
-                      'delay_threshold', 'robot_wait_timeout', 'plan_uptake_timeout')
-"""Honoured when set at run time (read at each use); every other parameter is read-only."""
-
 
 SOLVER_NICENESS = 10
 
@@ -157,49 +152,13 @@ def describe(note: Note) -> str:
 
 
 class PlannerNode(Node):
-    def __init__(self):
-        super().__init__(PLANNER_NODE)
-        scenario = declare(self, 'scenario', '',
-                           'scenario file of a mission to run at start-up; empty: wait for '
-                           'RunMission goals')
-        panels = declare(self, 'panels', 0, "panels of the scenario's job set; 0: the file's",
-                         low=0, high=50)
-        shift = declare(self, 'shift', -1.0,
-                        "distance added per panel apart; negative: the file's", low=-1.0,
-                        high=1e6)
-        self.solver = declare(self, 'solver', 'cpsat', 'solver of the first plan',
-                              constraints='one of: ' + ', '.join(SOLVERS))
-        if self.solver not in SOLVERS:
-            raise ParameterError(f"parameter 'solver' must be one of {', '.join(SOLVERS)}, "
-                                 f'got {shorten(self.solver, 80)!r}')
-        declare(self, 'time_limit', 10.0, 'seconds the first plan may take', low=0.01,
-                high=3600.0, read_only=False)
-        declare(self, 'replan_time_limit', 1.0, 'seconds a re-plan may take', low=0.01,
-                high=600.0, read_only=False)
-        declare(self, 'workers', 2, 'CP-SAT search workers', low=1, high=64, read_only=False)
-        declare(self, 'heartbeat_timeout', 1.0,
-                'seconds without a robot state before a robot is offline', low=0.05,
-                high=600.0, read_only=False)
-        declare(self, 'delay_threshold', 2.0,
-                'schedule units an operation may run late before a re-plan', low=0.0,
-                high=1e6, read_only=False)
-        declare(self, 'robot_wait_timeout', 15.0,
-                'seconds to wait for every robot to report before planning without it',
-                low=0.0, high=3600.0, read_only=False)
-        declare(self, 'plan_uptake_timeout', 10.0,
-                'seconds a reporting robot may stay on an older plan revision than the latest '
-                'before it is planned without', low=0.1, high=3600.0, read_only=False)
-        self.time_scale = declare(self, 'time_scale', 0.05,
-                                  'wall seconds per schedule unit', low=1e-4, high=1000.0)
-        self.start_delay = declare(self, 'start_delay', 0.5,
-                                   'seconds from the first plan to the mission start',
-                                   low=0.0, high=3600.0)
-        status_period = declare(self, 'status_period', 0.5,
-                                'seconds between periodic status publications', low=0.01,
-                                high=60.0)
-        journal_dir = declare(self, 'journal_dir', '',
-                              'directory of the mission journals that let a restarted planner '
-                              'resume its mission; empty: no journal')
+    def __init__(self, context=None):
+        super().__init__(PLANNER_NODE, context=context)
+        value = {name: declare(self, spec) for name, spec in PARAMETERS.items()}
+        scenario, panels, shift = value['scenario'], value['panels'], value['shift']
+        self.solver = value['solver']
+        self.time_scale, self.start_delay = value['time_scale'], value['start_delay']
+        status_period, journal_dir = value['status_period'], value['journal_dir']
         self.journal_dir = Path(journal_dir).expanduser() if journal_dir else None
         problem = None
         if scenario:
@@ -280,14 +239,8 @@ class PlannerNode(Node):
     # --- parameters and time -------------------------------------------------------------
 
     def settings(self) -> Settings:
-        value = {name: self.get_parameter(name).value for name in RUNTIME_PARAMETERS}
-        return Settings(time_limit=value['time_limit'],
-                        replan_time_limit=value['replan_time_limit'],
-                        heartbeat_timeout=value['heartbeat_timeout'],
-                        delay_threshold=value['delay_threshold'],
-                        robot_wait_timeout=value['robot_wait_timeout'],
-                        plan_uptake_timeout=value['plan_uptake_timeout'],
-                        start_delay=self.start_delay, time_scale=self.time_scale)
+        return Settings.from_parameters({name: self.get_parameter(name).value
+                                         for name in SETTINGS_PARAMETERS})
 
     def wall(self) -> float:
         return self.get_clock().now().nanoseconds * 1e-9

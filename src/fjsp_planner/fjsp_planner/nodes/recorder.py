@@ -19,6 +19,7 @@ from rclpy.qos import DurabilityPolicy, ReliabilityPolicy
 
 from fjsp_common.contract import TOPICS, subscription
 from fjsp_common.fleet import RECORDER_NODE
+from fjsp_common.parameters import ParameterSpec, table
 from fjsp_common.running import ParameterError, declare, run_node
 from fjsp_planner.observe.recording import (
     COMPRESSIONS,
@@ -28,6 +29,17 @@ from fjsp_planner.observe.recording import (
     message_definition,
 )
 from fjsp_planner.workspace import default_out_dir
+
+PARAMETERS = table(
+    ParameterSpec('out_dir', '', "directory of the recording; empty: the workspace's out/ "
+                  '(else ~/.ros/fjsp/out)'),
+    ParameterSpec('file_name', '', 'name of the .mcap file; empty: fjsp_<UTC start time>.mcap'),
+    ParameterSpec('compression', 'zstd', 'chunk compression of the MCAP file',
+                  choices=tuple(COMPRESSIONS)),
+    ParameterSpec('flush_period', 2.0, 'seconds between writes to disk (what a crash may lose)',
+                  low=0.1, high=3600.0),
+)
+"""The recorder's parameters, in the order it declares them."""
 
 
 def type_name(msg_type) -> str:
@@ -48,20 +60,9 @@ def installed_msg(package: str, name: str) -> str:
 class RecorderNode(Node):
     def __init__(self):
         super().__init__(RECORDER_NODE)
-        out_dir = declare(self, 'out_dir', '',
-                          "directory of the recording; empty: the workspace's out/ (else "
-                          '~/.ros/fjsp/out)')
-        file_name = declare(self, 'file_name', '',
-                            'name of the .mcap file; empty: fjsp_<UTC start time>.mcap')
-        compression = declare(self, 'compression', 'zstd',
-                              'chunk compression of the MCAP file',
-                              constraints='one of: ' + ', '.join(COMPRESSIONS))
-        flush_period = declare(self, 'flush_period', 2.0,
-                               'seconds between writes to disk (what a crash may lose)',
-                               low=0.1, high=3600.0)
-        if compression not in COMPRESSIONS:
-            raise ParameterError(f"parameter 'compression' must be one of "
-                                 f"{', '.join(COMPRESSIONS)}, got {compression!r}")
+        value = {name: declare(self, spec) for name, spec in PARAMETERS.items()}
+        out_dir, file_name = value['out_dir'], value['file_name']
+        compression = value['compression']
         directory = Path(out_dir).expanduser() if out_dir else default_out_dir()
         name = file_name or f"fjsp_{datetime.now(UTC).strftime('%Y%m%dT%H%M%S')}.mcap"
         if Path(name).name != name:
@@ -88,7 +89,7 @@ class RecorderNode(Node):
         except RecordingError as error:
             self.writer.close()
             raise ParameterError(f'cannot record: {error}') from None
-        self.create_timer(flush_period, self.flush)
+        self.create_timer(value['flush_period'], self.flush)
         self.get_logger().info(f'recording {len(TOPICS)} topics to {self.writer.path}')
 
     def recording(self, channel: int):
