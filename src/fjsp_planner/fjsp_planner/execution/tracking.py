@@ -22,7 +22,7 @@ from fractions import Fraction
 
 from fjsp_common.revisions import void
 from fjsp_common.vocabulary import EventKind, RobotMode
-from fjsp_planner.execution.replan import ExecutionState, RobotState
+from fjsp_planner.execution.replan import ExecutionState, RobotSituation
 from fjsp_planner.model.limits import shown
 from fjsp_planner.model.problem import Problem
 from fjsp_planner.model.schedule import JobAssignment, Schedule
@@ -486,7 +486,7 @@ class MissionTracker:
             # Nor is it free before its release time, however idle it looks.
             free_at = max(free_at, Fraction(robot.release_time))
             failed_at = None if r.last_failure_at is None else Fraction(r.last_failure_at)
-            robots[name] = RobotState(name, r.healthy, location, free_at, failed_at)
+            robots[name] = RobotSituation(name, r.healthy, location, free_at, failed_at)
         done_as = {name: self.jobs[name].done_as for name in self.done
                    if self.jobs[name].done_as is not None}
         return ExecutionState(now_f, self.done, running, robots, done_as)

@@ -38,7 +38,7 @@ from fjsp_planner.execution.mission.reports import EventReport, RobotReport
 from fjsp_planner.execution.mission.resume import restarted_while_down, restore, started_where
 from fjsp_planner.execution.mission.settings import Settings
 from fjsp_planner.execution.mission.states import INITIAL, check_transition
-from fjsp_planner.execution.replan import ExecutionState, Replan, RobotState, residual_problem
+from fjsp_planner.execution.replan import ExecutionState, Replan, RobotSituation, residual_problem
 from fjsp_planner.execution.tracking import Ignored, MissionTracker
 from fjsp_planner.model.problem import Problem
 from fjsp_planner.model.schedule import Result, Schedule, Status
@@ -435,7 +435,7 @@ class MissionController:
             location = robot.start_location
             if robot.name in fleet and at in locations and at != location:
                 location, moved = at, True
-            robots[robot.name] = RobotState(robot.name, robot.name in fleet, location,
+            robots[robot.name] = RobotSituation(robot.name, robot.name in fleet, location,
                                             robot.release_time)
         if not moved and len(fleet) == len(problem.robots):
             return None
