@@ -260,9 +260,9 @@ class MissionController:
                         for job in mission.tracker.agent_restarted(
                             report.robot, at=self._units(mission, wall))]
         if report.robot not in mission.tracker.robots:
-            outcome = mission.tracker.record_robot_state(report.robot, report.mode, '', '',
+            verdict = mission.tracker.record_robot_state(report.robot, report.mode, '', '',
                                                          math.nan)
-            if outcome.repeated:
+            if verdict.repeated:
                 return []
             return [Note(MissionEventKind.WARNING, (self._unknown(report.robot),),
                          robot=report.robot)]
@@ -309,18 +309,18 @@ class MissionController:
             return [], (f"job-done event '{event.event_id}': only the planner declares jobs "
                         'done')
         aborted_before = event.job in tracker.aborted
-        outcome = tracker.record_event(event.event_id, event.kind, event.robot, event.job,
+        verdict = tracker.record_event(event.event_id, event.kind, event.robot, event.job,
                                        event.revision, event.time)
-        if outcome.ignored:
-            return [], f'{outcome.ignored} event: {outcome.reason}'
+        if verdict.ignored:
+            return [], f'{verdict.ignored} event: {verdict.reason}'
         mission.reports += 1
         effects: list[Effect] = []
         if event.kind == EventKind.ABORTED and not aborted_before \
                 and event.job in tracker.aborted:
             effects.append(Note(MissionEventKind.JOB_ABORTED,
                                 (f"robot '{event.robot}' aborted it",), job=event.job))
-        if outcome.job_done is not None:
-            job, end = outcome.job_done
+        if verdict.job_done is not None:
+            job, end = verdict.job_done
             effects.append(JobDone(job, end, tracker.revision, tracker.jobs[job].done_as))
             if tracker.complete and not mission.state.ended:
                 effects += self._complete(mission)
