@@ -145,43 +145,43 @@ class MonitorNode(Node):
     # --- the log ---------------------------------------------------------------------
 
     def refresh(self) -> None:
-        now = time.time()
+        wall = time.time()
         log = self.get_logger()
         for mission in self.missions_by_start():
-            for item in views.story(self.fleet, mission, now):
+            for item in views.story(self.fleet, mission, wall):
                 if (mission.mission_id, item['key']) not in self.told:
                     self.told.add((mission.mission_id, item['key']))
                     log.info(text.story_line(item))
         current = self.fleet.current()
-        shown, key = text.frame(views.header(current, now) if current is not None else None,
-                                views.robot_rows(self.fleet, current, now))
+        shown, key = text.frame(views.header(current, wall) if current is not None else None,
+                                views.robot_rows(self.fleet, current, wall))
         if key != self.frame_key:
             self.frame_key = key
             log.info('\n' + shown)
-        self.draw_ended(now)
+        self.draw_ended(wall)
 
     def missions_by_start(self) -> list[MissionHistory]:
         return sorted(self.fleet.missions.values(), key=lambda m: m.last_stamp)
 
-    def draw_ended(self, now: float) -> None:
+    def draw_ended(self, wall: float) -> None:
         """Summarise and draw each mission once it ended and its last events came in."""
         for mission in list(self.fleet.missions.values()):
             if not mission.ended or mission.mission_id in self.drawn:
                 continue
-            since = self.ended_since.setdefault(mission.mission_id, now)
-            if not mission.agrees_with_status() and now - since < self.event_grace:
+            since = self.ended_since.setdefault(mission.mission_id, wall)
+            if not mission.agrees_with_status() and wall - since < self.event_grace:
                 continue
             self.drawn.add(mission.mission_id)
-            self.report(mission, now)
+            self.report(mission, wall)
             if self.exit_on_complete:
                 self.finished = True
 
-    def report(self, mission: MissionHistory, now: float) -> None:
+    def report(self, mission: MissionHistory, wall: float) -> None:
         """Log the summary; write the Gantt chart and the history (JSON) to out_dir."""
         log = self.get_logger()
         path = self.out_dir / f'{safe_file_name(mission.mission_id)}.png'
         try:
-            write_mission(self.fleet, mission, now, path)
+            write_mission(self.fleet, mission, wall, path)
             where = f'Gantt chart: {path}'
         except OSError as error:
             where = f'could not write the Gantt chart {path}: {error.strerror or error}'
@@ -191,29 +191,29 @@ class MonitorNode(Node):
 
     def push_page(self) -> None:
         """Send the page what changed since the last push."""
-        now = time.time()
+        wall = time.time()
         version, at = self.pushed_version
-        if self.fleet.version == version and now - at < TIMELINE_PERIOD:
+        if self.fleet.version == version and wall - at < TIMELINE_PERIOD:
             return
-        self.pushed_version = (self.fleet.version, now)
+        self.pushed_version = (self.fleet.version, wall)
         current = self.fleet.current()
         parts = {'missions': views.missions(self.fleet)}
-        parts['robots'] = views.robot_rows(self.fleet, current, now)
+        parts['robots'] = views.robot_rows(self.fleet, current, wall)
         if current is None:
             parts['mission'] = {'mission_id': '', 'scenario': '', 'state': 'no mission yet',
                                 'planner': views.planner_state(self.fleet)}
         else:
-            header = views.header(current, now)
+            header = views.header(current, wall)
             header['planner'] = views.planner_state(self.fleet)
             parts['mission'] = header
-            parts['story'] = views.story(self.fleet, current, now)
+            parts['story'] = views.story(self.fleet, current, wall)
             # The timeline is the largest part: rebuilt when the mission's facts changed, else
             # only as often as its clock needs.
             mission_id, version, at = self.pushed_timeline
             if (mission_id, version) != (current.mission_id, current.version) \
-                    or now - at >= TIMELINE_PERIOD:
-                self.pushed_timeline = (current.mission_id, current.version, now)
-                parts['timeline'] = views.timeline(self.fleet, current, now)
+                    or wall - at >= TIMELINE_PERIOD:
+                self.pushed_timeline = (current.mission_id, current.version, wall)
+                parts['timeline'] = views.timeline(self.fleet, current, wall)
         self.dashboard.publish(parts)
 
     # --- diagnostics -----------------------------------------------------------------
@@ -222,8 +222,8 @@ class MonitorNode(Node):
         current = self.fleet.current()
         if current is None:
             return
-        now = time.time()
-        silent = self.fleet.silent(current, now)
+        wall = time.time()
+        silent = self.fleet.silent(current, wall)
         statuses = []
         for robot in current.robot_names():
             state = self.fleet.robots.get(robot)
@@ -234,7 +234,7 @@ class MonitorNode(Node):
                 late_by=self.lateness(current, state) if state is not None else 0.0,
                 late_threshold=self.late_threshold,
                 refusal=state.refusal if state is not None else '',
-                silent_for=now - silent[robot] if robot in silent else None,
+                silent_for=wall - silent[robot] if robot in silent else None,
                 values={'mission': current.mission_id,
                         'plan revision': state.revision if state is not None else 0,
                         'location': state.location if state is not None else ''}))

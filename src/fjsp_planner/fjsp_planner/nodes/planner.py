@@ -586,8 +586,8 @@ class PlannerNode(Node):
                                       time_limit=request.time_limit, workers=workers)
         elif request.kind == SolveKind.REPAIR:
             self.replan_began = time.monotonic()
-            now = self.controller.now_units(self.wall())
-            self.get_logger().warning(f're-planning at t={now:.2f}: '
+            now_units = self.controller.now_units(self.wall())
+            self.get_logger().warning(f're-planning at t={now_units:.2f}: '
                                       + shorten('; '.join(request.reasons), 2000))
             future = self.pool.submit(repair, request.problem, request.previous,
                                       request.state, time_limit=request.time_limit)
@@ -679,12 +679,12 @@ class PlannerNode(Node):
         if effect.revision > 1 and self.replan_began is not None:
             self.replan_latency, self.replan_began = time.monotonic() - self.replan_began, None
         gap = f', gap {result.gap:.1%}' if result.gap is not None else ''
-        now = self.controller.now_units(self.wall())
+        now_units = self.controller.now_units(self.wall())
         log.info(f'published plan revision {effect.revision}: makespan '
                  f'{float(result.makespan):g} ({result.status}{gap}, '
                  f'{result.solve_seconds:.2f} s)'
                  + (f'; mission starts in {self.start_delay:g} s at {self.time_scale:g} s '
-                    'per unit' if effect.revision == 1 else f' at t={now:.2f}'))
+                    'per unit' if effect.revision == 1 else f' at t={now_units:.2f}'))
         for robot_plan in msg.robots:
             log.info(f'  {robot_plan.robot}: '
                      + (' -> '.join(t.job for t in robot_plan.tasks) or 'no task'))

@@ -555,12 +555,12 @@ class FleetHistory:
         # Progress and heartbeats change the live view even when the trail does not.
         return True
 
-    def silent(self, mission: MissionHistory | None, now: float) -> dict[str, float]:
-        """Robots silent at wall time `now` (robot -> its last stamp): those following
+    def silent(self, mission: MissionHistory | None, wall: float) -> dict[str, float]:
+        """Robots silent at wall time `wall` (robot -> its last stamp): those following
         `mission` or no mission yet; with `mission` None, every robot."""
         return {robot: state.stamp for robot, state in self.robots.items()
                 if (mission is None or state.mission_id in ('', mission.mission_id))
-                and now - state.stamp > self.heartbeat_timeout}
+                and wall - state.stamp > self.heartbeat_timeout}
 
     def current(self) -> MissionHistory | None:
         """The mission the planner reports on most recently (else the latest planned)."""

@@ -67,16 +67,16 @@ def main(argv=None) -> int:
         print(f'replay: {args.recording} holds no {which}', file=sys.stderr)
         return 1
     out = args.out if args.out is not None else args.recording.resolve().parent
-    now = reading.last_time
+    wall = reading.last_time
     for mission in sorted(missions, key=lambda m: m.last_stamp):
         print()
         print(text.summary(mission))
-        for item in views.story(fleet, mission, now):
+        for item in views.story(fleet, mission, wall):
             print('  ' + text.story_line(item))
         if not args.no_chart:
             png = out / f'{safe_file_name(mission.mission_id)}.replay.png'
             try:
-                write_mission(fleet, mission, now, png)
+                write_mission(fleet, mission, wall, png)
             except OSError as error:
                 print(f'replay: cannot write {png}: {error.strerror or error}',
                       file=sys.stderr)
