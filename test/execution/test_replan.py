@@ -22,7 +22,7 @@ import pytest
 
 from fjsp_planner.execution.replan import (
     ExecutionState,
-    RobotState,
+    RobotSituation,
     StateError,
     frozen,
     improve,
@@ -81,9 +81,9 @@ def test_the_plan_is_valid_and_simulates_as_drawn(small):
     state = at(small, Fraction(5, 2))
     assert state.done == {'J'}
     assert set(state.running) == {'P'}
-    assert state.robots['A'] == RobotState('A', True, 'p', Fraction(5, 2))
-    assert state.robots['B'] == RobotState('B', True, 'p', Fraction(3))
-    assert state.robots['C'] == RobotState('C', True, 'q', Fraction(4))
+    assert state.robots['A'] == RobotSituation('A', True, 'p', Fraction(5, 2))
+    assert state.robots['B'] == RobotSituation('B', True, 'p', Fraction(3))
+    assert state.robots['C'] == RobotSituation('C', True, 'q', Fraction(4))
 
 
 def test_failure_while_travelling_keeps_running_jobs(small):
@@ -233,8 +233,8 @@ def test_recovered_robot_unblocks(small):
     state = at(small, 1, {'A', 'B'})
     later = ExecutionState(Fraction(5), state.done, {}, {
         **state.robots,
-        'B': RobotState('B', True, 'p', Fraction(5)),
-        'C': RobotState('C', True, 'q', Fraction(5))})
+        'B': RobotSituation('B', True, 'p', Fraction(5)),
+        'C': RobotSituation('C', True, 'q', Fraction(5))})
     residual = residual_problem(small, later, PLAN)
     assert residual.blocked == []
     assert [r.name for r in residual.problem.robots] == ['B', 'C']
@@ -290,8 +290,8 @@ def test_replan_after_recovery(small):
     assert replan(small, PLAN, state).residual.blocked
     later = ExecutionState(Fraction(5), state.done, {}, {
         **state.robots,
-        'B': RobotState('B', True, 'p', Fraction(5)),
-        'C': RobotState('C', True, 'q', Fraction(5))})
+        'B': RobotSituation('B', True, 'p', Fraction(5)),
+        'C': RobotSituation('C', True, 'q', Fraction(5))})
     assert check_replan(small, PLAN, later, time_limit=5.0).result.makespan == 20
 
 
@@ -431,7 +431,7 @@ BAD_STATES = [
      lambda s: replace(s, running={'P': assign('P', 0, 3, {'B': 0})}),
      r"running job 'P': robots do \[0\], but plan 0 is \[1\]"),
     ('a state for an unknown robot',
-     lambda s: _with_robot(s, RobotState('Z', True, None, Fraction(0))),
+     lambda s: _with_robot(s, RobotSituation('Z', True, None, Fraction(0))),
      "robot state for unknown robot 'Z'"),
     ('a robot without a state',
      lambda s: replace(s, robots={k: v for k, v in s.robots.items() if k != 'C'}),
@@ -439,7 +439,8 @@ BAD_STATES = [
     ('a holder at work elsewhere',
      lambda s: replace(s, running={'P': assign('P', 0, 3, {'A': 1})}),
      "robot 'A' is running 'P' while it should still hold since 'J'"),
-    ('an unknown location', lambda s: _with_robot(s, RobotState('C', True, 'moon', Fraction(4))),
+    ('an unknown location',
+     lambda s: _with_robot(s, RobotSituation('C', True, 'moon', Fraction(4))),
      "robot 'C' is at unknown location 'moon'"),
 ]
 

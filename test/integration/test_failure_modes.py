@@ -4,7 +4,8 @@ request or redid work before it was fixed."""
 import threading
 import time
 
-from fjsp_common.contract import PLAN_TOPIC, agent_node_name
+from fjsp_common.contract import PLAN_TOPIC
+from fjsp_common.fleet import agent_node_name
 from fjsp_msgs.msg import MissionEvent, MissionStatus, TaskEvent
 from fjsp_planner.faults import FaultError, inject_fault
 

@@ -7,7 +7,7 @@ from collections import Counter
 import pytest
 import yaml
 
-from fjsp_common.contract import agent_node_name
+from fjsp_common.fleet import agent_node_name
 from fjsp_msgs.msg import MissionStatus, RobotState, TaskEvent
 from fjsp_planner.missions import MissionClient, MissionError
 from fjsp_planner.model.scenario import load_scenario

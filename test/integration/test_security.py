@@ -8,7 +8,7 @@ import time
 
 import pytest
 
-from fjsp_common.auth import PLANNER, FleetKeyError, Signer, Verifier, new_key, read_key
+from fjsp_common.auth import FleetKeyError, Signer, Verifier, new_key, read_key
 from fjsp_common.contract import (
     EVENTS_QOS,
     LATCHED_QOS,
@@ -16,6 +16,7 @@ from fjsp_common.contract import (
     ROBOT_STATES_TOPIC,
     TASK_EVENTS_TOPIC,
 )
+from fjsp_common.fleet import PLANNER_NODE
 from fjsp_msgs.msg import MissionStatus, Plan, RobotState, TaskEvent
 from fjsp_planner.faults import FaultError, inject_fault
 
@@ -54,10 +55,10 @@ def test_a_signed_message_verifies_once_and_only_unchanged(key_file):
 def test_a_restarted_sender_counts_afresh_but_an_old_one_is_refused(key_file):
     key = read_key(key_file)
     verifier = Verifier(key)
-    old = Signer(key, PLANNER)
+    old = Signer(key, PLANNER_NODE)
     first = old.sign(Plan(revision=1), '/plan')
     time.sleep(0.001)
-    new = Signer(key, PLANNER)
+    new = Signer(key, PLANNER_NODE)
     assert verifier.check(new.sign(Plan(revision=2), '/plan'), '/plan') == ''
     assert 'replayed' in verifier.check(first, '/plan')
 
@@ -103,7 +104,7 @@ def test_forged_plan_event_and_state_are_dropped(fjsp_fleet, key_file, tmp_path)
     takeover = copy.deepcopy(real)
     takeover.revision, takeover.robots = 99, []
     plans.publish(takeover)                       # unsigned
-    wrong_key = Signer(read_key(new_key(tmp_path / 'other.key')), PLANNER)
+    wrong_key = Signer(read_key(new_key(tmp_path / 'other.key')), PLANNER_NODE)
     plans.publish(wrong_key.sign(copy.deepcopy(takeover), '/plan'))
     remaining = [t.job for r in real.robots for t in r.tasks][-1]
     events.publish(TaskEvent(event_id='planner/x/1', mission_id=mission,

@@ -22,6 +22,7 @@ from pathlib import Path
 
 import pytest
 
+from fjsp_common.fleet import agent_node_name
 from fjsp_msgs.msg import MissionStatus, RobotState, TaskEvent
 from fjsp_planner.faults import FaultError
 from fjsp_planner.missions import MissionClient, MissionError
@@ -33,7 +34,6 @@ from fjsp_planner.testing import (
     valid_events,
     validate_executed,
 )
-from robot_agents.agent_node import agent_node_name
 
 from repo_paths import SCENARIOS
 

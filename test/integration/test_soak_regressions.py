@@ -3,9 +3,9 @@ its own that reproduces it on purpose."""
 
 import time
 
+from fjsp_common.fleet import agent_node_name
 from fjsp_msgs.msg import MissionStatus, RobotState, TaskEvent
 from fjsp_planner.testing import valid_events
-from robot_agents.agent_node import agent_node_name
 
 from repo_paths import SCENARIOS
 

@@ -1,6 +1,18 @@
 """The fleet's shared contract: what the planner, the robot agents and any monitor agree on.
 
-`vocabulary` (no ROS) names robot modes, event kinds and mission states once; `contract` maps
-them to the message constants and fixes topic names and QoS; `running` is how every node reads
-its parameters and runs.
+Free of ROS, so the domain core and tools use them too:
+
+- `vocabulary`: robot modes, event kinds and mission states, named once;
+- `fleet`: node names and the defaults the whole fleet shares (heartbeat period and timeout);
+- `clock`: one mission's schedule clock, wall seconds <-> schedule units;
+- `revisions`: which attempt at a job a report is about, and whether it still counts;
+- `parameters`: a node parameter's one definition (`ParameterSpec`).
+
+With ROS:
+
+- `contract`: the topic table (names, message types, QoS) and the vocabularies paired with
+  the message constants;
+- `running`: how every node declares its parameters and runs;
+- `auth`: the fleet key, signing and checking;
+- `diagnostics`: health on `/diagnostics`.
 """

@@ -24,14 +24,16 @@ import time
 from collections import Counter
 from pathlib import Path
 
+from fjsp_common.parameters import ParameterSpec
 from fjsp_common.running import ParameterError, declare, shorten
 from fjsp_msgs.msg import Auth
 
 KEY_BYTES = 32
 KEY_FILE_VARIABLE = 'FJSP_FLEET_KEY_FILE'
 """Where command-line tools and scripts find the fleet key when not told otherwise."""
-PLANNER = 'planner'
-"""The sender name of the fleet's planner: the only one whose plans and verdicts count."""
+FLEET_KEY_FILE = ParameterSpec('fleet_key_file', '',
+                               'file holding the fleet key (hex); empty: unauthenticated')
+"""The parameter every node that signs or checks messages has."""
 
 
 class FleetKeyError(ValueError):
@@ -162,8 +164,7 @@ class NodeAuth:
 
     def __init__(self, node, sender: str):
         self.node = node
-        path = declare(node, 'fleet_key_file', '',
-                       'file holding the fleet key (hex); empty: unauthenticated')
+        path = declare(node, FLEET_KEY_FILE)
         key = None
         if path:
             try:

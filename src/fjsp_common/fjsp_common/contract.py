@@ -1,14 +1,20 @@
 """Topic names, QoS profiles and message constants the whole fleet agrees on.
 
 Names are relative, so a whole fleet can be moved into a namespace with `-r __ns:=/cell1`.
-Every vocabulary of `fjsp_common.vocabulary` is paired here with its message constants by
-name; a vocabulary word without a constant (or the reverse) fails at import, not in a mission.
+`TOPICS` is the one table of the fleet's topics, each with its message type and QoS: every
+node publishes and subscribes through it (`publisher`, `subscription`). Every vocabulary of
+`fjsp_common.vocabulary` is paired here with its message constants by name; a vocabulary
+word without a constant (or the reverse) fails at import, not in a mission.
 """
 
+from dataclasses import dataclass
+
+from diagnostic_msgs.msg import DiagnosticArray
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
+from fjsp_common.diagnostics import DIAGNOSTICS_QOS, DIAGNOSTICS_TOPIC
 from fjsp_common.vocabulary import EventKind, MissionEventKind, MissionState, RobotMode
-from fjsp_msgs.msg import MissionEvent, MissionStatus, RobotState, TaskEvent
+from fjsp_msgs.msg import JobStates, MissionEvent, MissionStatus, Plan, RobotState, TaskEvent
 
 PLAN_TOPIC = 'plan'
 ROBOT_STATES_TOPIC = 'robot_states'
@@ -21,11 +27,6 @@ INJECT_FAULT_SERVICE = 'inject_fault'
 RUN_MISSION_ACTION = 'run_mission'
 ADD_JOBS_SERVICE = 'add_jobs'
 CANCEL_MISSION_SERVICE = 'cancel_mission'
-
-def agent_node_name(robot: str) -> str:
-    """The node of a robot's agent: one per robot, so no two nodes of a fleet share a name."""
-    return f'agent_{robot}'
-
 
 MAX_FLEET = 128
 """Robot states a late joiner catches up on: at least the largest fleet a scenario may have."""
@@ -70,6 +71,40 @@ FAULT_REQUESTS_QOS = QoSProfile(
 )
 """An agent's fault service queues this many requests; the default (10) dropped most of a
 burst of 40, leaving their callers waiting out their timeouts."""
+
+
+@dataclass(frozen=True)
+class Topic:
+    name: str
+    type: type
+    qos: QoSProfile
+    """What its readers subscribe with, and its writers publish with unless `writer_qos`
+    says otherwise."""
+    writer_qos: QoSProfile | None = None
+
+
+PLAN = Topic(PLAN_TOPIC, Plan, LATCHED_QOS)
+ROBOT_STATES = Topic(ROBOT_STATES_TOPIC, RobotState, ROBOT_STATES_QOS, writer_qos=LATCHED_QOS)
+"""Each agent's writer keeps only its latest state; readers keep one per robot."""
+TASK_EVENTS = Topic(TASK_EVENTS_TOPIC, TaskEvent, EVENTS_QOS)
+MISSION_EVENTS = Topic(MISSION_EVENTS_TOPIC, MissionEvent, EVENTS_QOS)
+MISSION_STATUS = Topic(MISSION_STATUS_TOPIC, MissionStatus, LATCHED_QOS)
+JOB_STATES = Topic(JOB_STATES_TOPIC, JobStates, LATCHED_QOS)
+DIAGNOSTICS = Topic(DIAGNOSTICS_TOPIC, DiagnosticArray, DIAGNOSTICS_QOS)
+
+TOPICS = (PLAN, ROBOT_STATES, TASK_EVENTS, MISSION_EVENTS, MISSION_STATUS, JOB_STATES,
+          DIAGNOSTICS)
+"""Every topic of a mission."""
+
+
+def publisher(node, topic: Topic):
+    """A publisher of `topic` on `node`, with the QoS its writers use."""
+    return node.create_publisher(topic.type, topic.name, topic.writer_qos or topic.qos)
+
+
+def subscription(node, topic: Topic, callback, **options):
+    """A subscription of `node` to `topic`, with the QoS its readers use."""
+    return node.create_subscription(topic.type, topic.name, callback, topic.qos, **options)
 
 
 def _pair(vocabulary, message, prefix: str) -> tuple[dict, dict]:

@@ -2,9 +2,10 @@
 a bad one with a one-line reason and exit code 2, and stop quietly on Ctrl-C, SIGTERM or an
 external shutdown.
 
-Parameters carry a `ParameterDescriptor` (description, range, read-only), so `ros2 param
-describe` documents them and rclpy itself refuses an out-of-range or read-only `set`, at
-start-up (`-p`, `--params-file`) and at run time alike.
+Parameters are declared from their definitions (`fjsp_common.parameters`) with a
+`ParameterDescriptor` (description, range, read-only), so `ros2 param describe` documents them
+and rclpy itself refuses an out-of-range or read-only `set`, at start-up (`-p`,
+`--params-file`) and at run time alike.
 """
 
 import re
@@ -18,44 +19,41 @@ from rclpy.exceptions import InvalidParameterTypeException, InvalidParameterValu
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.node import Node
 
+from fjsp_common.parameters import ParameterSpec
+
 
 class ParameterError(ValueError):
     """A node parameter with a value the node cannot run with."""
 
 
-def declare(node: Node, name: str, default, description: str, *, low=None, high=None,
-            read_only: bool = True, constraints: str = ''):
-    """Declare parameter `name` (its type is `default`'s) and return its value.
-
-    Numbers need both `low` and `high`: rclpy checks the range on every set, and NaN or an
-    infinity is outside any finite range. `read_only` parameters are the ones the node reads
-    once; a set at run time is refused instead of being accepted and ignored.
-    """
-    descriptor = ParameterDescriptor(description=description, read_only=read_only,
-                                     additional_constraints=constraints)
-    if isinstance(default, bool) or not isinstance(default, int | float):
-        if low is not None or high is not None:
-            raise TypeError(f"parameter '{name}': a range needs a numeric default")
-    elif low is None or high is None:
-        raise TypeError(f"parameter '{name}': a number needs both ends of its range")
-    elif isinstance(default, float):
+def declare(node: Node, spec: ParameterSpec):
+    """Declare the parameter `spec` defines and return its value; ParameterError, naming it
+    and why, for a value the node cannot run with."""
+    descriptor = ParameterDescriptor(description=spec.description, read_only=spec.read_only,
+                                     additional_constraints=spec.constraints)
+    name, default, low, high = spec.name, spec.default, spec.low, spec.high
+    if isinstance(default, float):
         descriptor.floating_point_range = [FloatingPointRange(
             from_value=float(low), to_value=float(high), step=0.0)]
-    else:
+    elif isinstance(default, int) and not isinstance(default, bool):
         descriptor.integer_range = [IntegerRange(from_value=low, to_value=high, step=0)]
     try:
-        return node.declare_parameter(name, default, descriptor).value
+        value = node.declare_parameter(name, default, descriptor).value
     except InvalidParameterTypeException as error:
         raise ParameterError(f"parameter '{name}' must be of type {_kind(default)}, like "
-                             f'{default!r} ({description}): {error}') from None
+                             f'{default!r} ({spec.description}): {error}') from None
     except InvalidParameterValueException as error:
         # rclpy keeps the refused value only in its message.
         given = re.search(r'value \((.*)\) for parameter', str(error), re.DOTALL)
         why = (f'must be within [{_number(low)}, {_number(high)}]' if low is not None
                else 'was refused')
-        raise ParameterError(f"parameter '{name}' {why} ({description}), got "
+        raise ParameterError(f"parameter '{name}' {why} ({spec.description}), got "
                              f"{shorten(given.group(1), 80) if given else 'another value'}"
                              ) from None
+    if spec.choices and value not in spec.choices:
+        raise ParameterError(f"parameter '{name}' must be one of {', '.join(spec.choices)}, "
+                             f'got {shorten(value, 80)!r}')
+    return value
 
 
 def _kind(default) -> str:

@@ -43,16 +43,28 @@ class EventKind(StrEnum):
 
 
 class MissionState(StrEnum):
+    """Where a mission is, as `mission_status` says; the moves between states are one table,
+    `fjsp_planner.execution.mission.states.TRANSITIONS`."""
+
     IDLE = 'idle'
     """No mission: the planner waits for one."""
     WAITING_FOR_ROBOTS = 'waiting for robots'
+    """Accepted: waits until every robot reported (at most `robot_wait_timeout`)."""
     PLANNING = 'planning'
+    """Computing the first plan."""
     EXECUTING = 'executing'
+    """The robots follow the current plan."""
     REPLANNING = 'replanning'
+    """Computing a plan of what remains; the robots go on with the current one."""
     BLOCKED = 'blocked'
+    """The robots available cannot do what remains; waits for the fleet to change."""
     COMPLETE = 'complete'
+    """Ended: every job done, and the timeline the robots ran is valid."""
     CANCELLED = 'cancelled'
+    """Ended by a cancel request: the robots dropped their tasks."""
     FAILED = 'failed'
+    """Ended without completing: no valid plan, an invalid executed timeline, or blocked
+    longer than the mission's `blocked_timeout`."""
 
     @property
     def ended(self) -> bool:

@@ -36,27 +36,26 @@ from fractions import Fraction
 
 import pytest
 
+from fjsp_common.clock import ScheduleClock, seconds
 from fjsp_common.contract import (
-    EVENTS_QOS,
-    JOB_STATES_TOPIC,
-    LATCHED_QOS,
-    MISSION_EVENTS_TOPIC,
-    MISSION_STATUS_TOPIC,
-    PLAN_TOPIC,
-    ROBOT_STATES_QOS,
-    ROBOT_STATES_TOPIC,
-    TASK_EVENTS_TOPIC,
+    JOB_STATES,
+    MISSION_EVENTS,
+    MISSION_STATUS,
+    PLAN,
+    ROBOT_STATES,
+    TASK_EVENTS,
 )
+from fjsp_common.fleet import PLANNER_NODE, agent_node_name
+from fjsp_common.revisions import Restarts, plan_attempts
 from fjsp_msgs.msg import JobStates, MissionEvent, MissionStatus, Plan, RobotState, TaskEvent
 from fjsp_planner.execution.tracking import relaxed_distances
 from fjsp_planner.faults import inject_fault
 from fjsp_planner.launcher.hosts import HostsUnavailableError, Network
 from fjsp_planner.launcher.listener import Listener, environment
-from fjsp_planner.launcher.supervision import PLANNER_NODE, Fleet, find_executable
+from fjsp_planner.launcher.supervision import Fleet, find_executable
 from fjsp_planner.model.problem import Problem
 from fjsp_planner.model.schedule import JobAssignment, Schedule
 from fjsp_planner.model.validate import validate
-from robot_agents.agent_node import agent_node_name
 
 TEST_TIME_SCALE = 0.03
 """Wall seconds per schedule unit: the paper's 32-unit mission takes about a second."""
@@ -123,15 +122,12 @@ class Observer(Listener):
         self.robots: dict[str, RobotState] = {}
         """Latest state of each robot."""
         self.robot_history: list[RobotState] = []
-        self.subscribe(Plan, PLAN_TOPIC, LATCHED_QOS, self.plans.append)
-        self.subscribe(TaskEvent, TASK_EVENTS_TOPIC, EVENTS_QOS, self.events.append)
-        self.subscribe(MissionEvent, MISSION_EVENTS_TOPIC, EVENTS_QOS,
-                       self.mission_events.append)
-        self.subscribe(MissionStatus, MISSION_STATUS_TOPIC, LATCHED_QOS,
-                       lambda msg: setattr(self, 'status', msg))
-        self.subscribe(JobStates, JOB_STATES_TOPIC, LATCHED_QOS,
-                       lambda msg: setattr(self, 'job_states', msg))
-        self.subscribe(RobotState, ROBOT_STATES_TOPIC, ROBOT_STATES_QOS, self._robot)
+        for topic, callback in ((PLAN, self.plans.append), (TASK_EVENTS, self.events.append),
+                                (MISSION_EVENTS, self.mission_events.append),
+                                (MISSION_STATUS, lambda msg: setattr(self, 'status', msg)),
+                                (JOB_STATES, lambda msg: setattr(self, 'job_states', msg)),
+                                (ROBOT_STATES, self._robot)):
+            self.subscribe(topic.type, topic.name, topic.qos, callback)
 
     def _robot(self, msg: RobotState) -> None:
         self.robots[msg.robot] = msg
@@ -169,8 +165,8 @@ class Observer(Listener):
         """Schedule time now, from the first plan's mission start (-inf before any plan)."""
         if not self.plans:
             return -math.inf
-        start = self.plans[0].mission_start
-        return (time.time() - start.sec - start.nanosec * 1e-9) / self.plans[0].time_scale
+        first = self.plans[0]
+        return ScheduleClock(seconds(first.mission_start), first.time_scale).units(time.time())
 
     def jobs_done(self) -> set[str]:
         """Jobs declared done in their last attempt."""
@@ -394,22 +390,21 @@ def fjsp_fleet(tmp_path):
 
 # --- what the robots did, from their events ----------------------------------------------
 
-def restart_revisions(plans) -> dict[str, int]:
-    """Per job, the last plan revision that (re)started it: its reports under older ones are
-    void (`PlanTask.continued`, `PlanTask.restarted_in`)."""
-    since = {}
+def restarts_in(plans) -> Restarts:
+    """Per job, the last plan revision of `plans` that (re)started it: its reports under
+    older ones are void (`PlanTask.continued`, `PlanTask.restarted_in`)."""
+    restarts = Restarts()
     for plan in plans:
-        for robot in plan.robots:
-            for task in robot.tasks:
-                attempt = plan.revision if not task.continued else task.restarted_in
-                since[task.job] = max(since.get(task.job, 0), attempt)
-    return since
+        tasks = (task for robot in plan.robots for task in robot.tasks)
+        for job, since in plan_attempts(plan.revision, tasks).items():
+            restarts.restart(job, since)
+    return restarts
 
 
 def valid_events(plans, events) -> list[TaskEvent]:
     """The events of each job's last attempt, the one that counts."""
-    since = restart_revisions(plans)
-    return [e for e in events if e.plan_revision >= since.get(e.job, 0)]
+    restarts = restarts_in(plans)
+    return [e for e in events if not restarts.void(e.job, e.plan_revision)]
 
 
 def executed_timeline(problem: Problem, plans, events) -> Schedule:

@@ -13,34 +13,42 @@ through `<robot_name>/inject_fault` (`fjsp_planner.faults`).
 
 import sys
 from collections import deque
+from dataclasses import replace
 from pathlib import Path
 
-from diagnostic_msgs.msg import DiagnosticArray
 from rclpy.exceptions import InvalidServiceNameException
 from rclpy.node import Node
 from rclpy.time import Time as RosTime
 
-from fjsp_common.auth import PLANNER, NodeAuth
+from fjsp_common.auth import NodeAuth
+from fjsp_common.clock import ScheduleClock, seconds
 from fjsp_common.contract import (
+    DIAGNOSTICS,
     EVENT_FROM_MSG,
     EVENT_HISTORY,
     EVENT_TO_MSG,
-    EVENTS_QOS,
     FAULT_REQUESTS_QOS,
     INJECT_FAULT_SERVICE,
-    LATCHED_QOS,
     MODE_TO_MSG,
+    PLAN,
     PLAN_TOPIC,
+    ROBOT_STATES,
     ROBOT_STATES_TOPIC,
+    TASK_EVENTS,
     TASK_EVENTS_TOPIC,
+    publisher,
+    subscription,
+)
+from fjsp_common.diagnostics import diagnostic_array, robot_diagnostic
+from fjsp_common.fleet import (
+    DIAGNOSTICS_PERIOD,
+    HEARTBEAT_PERIOD,
+    LATE_THRESHOLD,
+    PLANNER_NODE,
     agent_node_name,
 )
-from fjsp_common.diagnostics import (
-    DIAGNOSTICS_QOS,
-    DIAGNOSTICS_TOPIC,
-    diagnostic_array,
-    robot_diagnostic,
-)
+from fjsp_common.parameters import ParameterSpec, table
+from fjsp_common.revisions import plan_attempts
 from fjsp_common.running import ParameterError, declare, run_node, shorten
 from fjsp_common.vocabulary import EventKind, RobotMode
 from fjsp_msgs.msg import Plan, RobotState, TaskEvent
@@ -52,36 +60,42 @@ ANSWERS_KEPT = 1024
 NAME_LOOKUP_NODE = 'robot_agent'
 """The short-lived node that reads `robot_name` before the agent's own node can be named."""
 
+ROBOT_NAME = ParameterSpec('robot_name', '',
+                           'name of the robot this agent plays, as the scenario lists it')
+ROBOT_TYPE = ParameterSpec('robot_type', '', 'robot type this agent must play; empty: whatever '
+                           'type the plan gives it')
+PARAMETERS = table(
+    ROBOT_NAME,
+    ROBOT_TYPE,
+    ParameterSpec('time_scale', 0.0, "wall seconds per schedule unit; 0: the plan's", low=0.0,
+                  high=1000.0),
+    ParameterSpec('tick_period', 0.01, 'seconds between steps of the simulated execution',
+                  low=0.001, high=1.0),
+    ParameterSpec('heartbeat_period', HEARTBEAT_PERIOD,
+                  'seconds between robot states published as heartbeat', low=0.01, high=10.0),
+    ParameterSpec('diagnostics_period', DIAGNOSTICS_PERIOD,
+                  'seconds between health reports on /diagnostics', low=0.1, high=60.0),
+    ParameterSpec('late_threshold', LATE_THRESHOLD, 'schedule units an operation may run past '
+                  'its plan before the robot reports WARN', low=0.0, high=1e6),
+    ParameterSpec('reports_dir', '', 'directory where the agent keeps its reports, so that a '
+                  'planner resuming a mission learns what this robot did before its agent '
+                  'restarted; empty: not kept'),
+)
+"""The agent's parameters, in the order it declares them; the agent's executable gives
+`robot_name` (read first, to name the node) and `robot_type` (pinned by the per-type aliases)
+their defaults."""
+
 
 class RobotAgent(Node):
     def __init__(self, robot: str, pinned_type: str = ''):
         super().__init__(agent_node_name(robot))
-        self.robot = declare(self, 'robot_name', robot,
-                             'name of the robot this agent plays, as the scenario lists it')
-        self.pinned_type = declare(
-            self, 'robot_type', pinned_type,
-            'robot type this agent must play; empty: whatever type the plan gives it') \
-            or pinned_type
-        self.time_scale = declare(
-            self, 'time_scale', 0.0, "wall seconds per schedule unit; 0: the plan's",
-            low=0.0, high=1000.0)
-        tick_period = declare(self, 'tick_period', 0.01,
-                              'seconds between steps of the simulated execution',
-                              low=0.001, high=1.0)
-        heartbeat_period = declare(self, 'heartbeat_period', 0.2,
-                                   'seconds between robot states published as heartbeat',
-                                   low=0.01, high=10.0)
-        diagnostics_period = declare(self, 'diagnostics_period', 1.0,
-                                     'seconds between health reports on /diagnostics',
-                                     low=0.1, high=60.0)
-        self.late_threshold = declare(
-            self, 'late_threshold', 2.0,
-            'schedule units an operation may run past its plan before the robot reports WARN',
-            low=0.0, high=1e6)
-        reports_dir = declare(
-            self, 'reports_dir', '',
-            'directory where the agent keeps its reports, so that a planner resuming a '
-            'mission learns what this robot did before its agent restarted; empty: not kept')
+        given = {ROBOT_NAME.name: robot, ROBOT_TYPE.name: pinned_type}
+        value = {name: declare(self, replace(spec, default=given.get(name, spec.default)))
+                 for name, spec in PARAMETERS.items()}
+        self.robot = value['robot_name']
+        self.pinned_type = value['robot_type'] or pinned_type
+        self.time_scale = value['time_scale']
+        self.late_threshold = value['late_threshold']
         if pinned_type and self.pinned_type != pinned_type:
             raise ParameterError(f"parameter 'robot_type': this executable plays a "
                                  f"'{pinned_type}', got '{self.pinned_type}' (use robot_agent "
@@ -96,8 +110,8 @@ class RobotAgent(Node):
         self.failures = 0
         self.execution = RobotExecution(self.robot)
         self.mission_id = ''
-        self.mission_start: RosTime | None = None
-        self.scale = self.time_scale
+        self.clock: ScheduleClock | None = None
+        """The followed mission's schedule time (None before its first plan)."""
         self.robot_type = self.pinned_type
         self.refusal = ''
         """Why the latest plan received is not followed ('' when it is)."""
@@ -107,10 +121,10 @@ class RobotAgent(Node):
         self.early_events: deque[TaskEvent] = deque(maxlen=EVENT_HISTORY)
         """Reports of a mission this robot does not follow (yet): its plan may come later."""
 
-        self.state_pub = self.create_publisher(RobotState, ROBOT_STATES_TOPIC, LATCHED_QOS)
-        self.event_pub = self.create_publisher(TaskEvent, TASK_EVENTS_TOPIC, EVENTS_QOS)
-        self.create_subscription(Plan, PLAN_TOPIC, self.on_plan, LATCHED_QOS)
-        self.create_subscription(TaskEvent, TASK_EVENTS_TOPIC, self.on_event, EVENTS_QOS)
+        self.state_pub = publisher(self, ROBOT_STATES)
+        self.event_pub = publisher(self, TASK_EVENTS)
+        subscription(self, PLAN, self.on_plan)
+        subscription(self, TASK_EVENTS, self.on_event)
         self.fault_service = f'{self.robot}/{INJECT_FAULT_SERVICE}'
         try:
             self.create_service(InjectFault, self.fault_service, self.on_fault,
@@ -118,11 +132,11 @@ class RobotAgent(Node):
         except InvalidServiceNameException:
             raise ParameterError(f"parameter 'robot_name' must be usable in a ROS name "
                                  f'(letters, digits, underscores), got {self.robot!r}') from None
-        self.diagnostics_pub = self.create_publisher(DiagnosticArray, DIAGNOSTICS_TOPIC,
-                                                     DIAGNOSTICS_QOS)
-        self.create_timer(tick_period, self.tick)
-        self.create_timer(heartbeat_period, self.publish_state)
-        self.create_timer(diagnostics_period, self.publish_diagnostics)
+        self.diagnostics_pub = publisher(self, DIAGNOSTICS)
+        self.create_timer(value['tick_period'], self.tick)
+        self.create_timer(value['heartbeat_period'], self.publish_state)
+        self.create_timer(value['diagnostics_period'], self.publish_diagnostics)
+        reports_dir = value['reports_dir']
         self.reports = self.open_reports(reports_dir) if reports_dir else None
         self.publish_state()
         kind = f"a '{self.pinned_type}'" if self.pinned_type else 'any type'
@@ -130,21 +144,20 @@ class RobotAgent(Node):
 
     def now_units(self) -> float | None:
         """Schedule time since the mission start, or None before the first plan."""
-        if self.mission_start is None:
+        if self.clock is None:
             return None
-        elapsed = (self.get_clock().now() - self.mission_start).nanoseconds * 1e-9
-        return elapsed / self.scale
+        return self.clock.units(self.get_clock().now().nanoseconds * 1e-9)
 
     # --- plans -------------------------------------------------------------------------
 
     def on_plan(self, msg: Plan) -> None:
-        if not self.auth.accept(msg, PLAN_TOPIC, {PLANNER}):
+        if not self.auth.accept(msg, PLAN_TOPIC, {PLANNER_NODE}):
             return
         log = self.get_logger()
         mission = shorten(msg.mission_id, 80)
         new_mission = msg.mission_id != self.mission_id
-        if new_mission and self.mission_start is not None \
-                and RosTime.from_msg(msg.mission_start) <= self.mission_start:
+        if new_mission and self.clock is not None \
+                and seconds(msg.mission_start) <= self.clock.mission_start:
             log.warning(f"ignoring plan of mission '{mission}': it started no later than "
                         f"mission '{self.mission_id}', which this robot follows")
             return
@@ -171,12 +184,11 @@ class RobotAgent(Node):
         if self.time_scale and self.time_scale != msg.time_scale:
             log.warning(f'running at time_scale {self.time_scale} s/unit while the plan '
                         f'assumes {msg.time_scale}: this robot runs off the planned pace')
-        job_robots, restarted_in = {}, {}
+        job_robots = {}
         for robot_plan in msg.robots:
             for t in robot_plan.tasks:
                 job_robots.setdefault(t.job, set()).add(robot_plan.robot)
-                since = t.restarted_in if t.continued else msg.revision
-                restarted_in[t.job] = max(restarted_in.get(t.job, 0), since)
+        restarted_in = plan_attempts(msg.revision, (t for r in msg.robots for t in r.tasks))
         tasks = [Task(job=t.job, operation_type=t.operation_type, location=t.location,
                       travel_start=t.travel_start, arrival=t.arrival, start=t.start,
                       operation_end=t.operation_end, end=t.end,
@@ -219,8 +231,7 @@ class RobotAgent(Node):
     def begin_mission(self, msg: Plan) -> None:
         self.execution.start_mission()
         self.mission_id = msg.mission_id
-        self.mission_start = RosTime.from_msg(msg.mission_start)
-        self.scale = self.time_scale or msg.time_scale
+        self.clock = ScheduleClock(seconds(msg.mission_start), self.time_scale or msg.time_scale)
         self.last_state = None
         early = [e for e in self.early_events if e.mission_id == msg.mission_id]
         self.early_events.clear()
@@ -239,7 +250,7 @@ class RobotAgent(Node):
     # --- what the others report --------------------------------------------------------
 
     def on_event(self, msg: TaskEvent) -> None:
-        senders = {PLANNER} if msg.kind == TaskEvent.KIND_JOB_DONE else {msg.robot}
+        senders = {PLANNER_NODE} if msg.kind == TaskEvent.KIND_JOB_DONE else {msg.robot}
         if not self.auth.accept(msg, TASK_EVENTS_TOPIC, senders):
             return
         if msg.mission_id != self.mission_id:
@@ -424,8 +435,7 @@ def robot_name_from_parameters() -> str:
     probe = Node(NAME_LOOKUP_NODE, start_parameter_services=False,
                  enable_rosout=False)
     try:
-        robot = declare(probe, 'robot_name', '',
-                        'name of the robot this agent plays, as the scenario lists it')
+        robot = declare(probe, ROBOT_NAME)
     finally:
         probe.destroy_node()
     if not robot:

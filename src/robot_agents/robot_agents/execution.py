@@ -21,6 +21,7 @@ import math
 from dataclasses import dataclass, field
 from enum import StrEnum
 
+from fjsp_common.revisions import Restarts, void
 from fjsp_common.vocabulary import MAX_DELAY_FACTOR, MIN_DELAY_FACTOR, EventKind, RobotMode
 
 # Reported ends are rounded up onto this grid (schedule units) so that float rounding never
@@ -139,8 +140,8 @@ class RobotExecution:
         self._arrived: dict[tuple[str, str], _Fact] = {}
         self._operation_done: dict[tuple[str, str], _Fact] = {}
         self._job_done: dict[str, _Fact] = {}
-        self._restarted: dict[str, int] = {}
-        """Job -> the latest revision that restarted it; older reports about it are void."""
+        self._restarts = Restarts()
+        """The latest revision that restarted each job: older reports about it are void."""
         self._attempts: dict[str, int] = {}
 
     # --- what the robot is doing -------------------------------------------------------
@@ -229,8 +230,7 @@ class RobotExecution:
             since = min(restarted_in.get(job, revision), revision)
             if since <= previous:  # else restarted in a revision this robot missed
                 continued.add(job)
-            if since > self._restarted.get(job, 0):
-                self._restart(job, since)
+            self._restart(job, since)
         self.tasks = tasks
         if self._phase == _Phase.FAILED:
             self._index = 0
@@ -269,14 +269,15 @@ class RobotExecution:
         return False
 
     def _restart(self, job: str, revision: int) -> None:
-        self._restarted[job] = revision
-        self._forget(job, lambda fact: fact.revision < revision)
+        if self._restarts.restart(job, revision):
+            self._forget(job, lambda fact: void(fact.revision, revision))
 
-    def _forget(self, job: str, void) -> None:
+    def _forget(self, job: str, stale) -> None:
+        """Drop the facts about `job` for which `stale(fact)` holds."""
         for facts in (self._arrived, self._operation_done):
-            for key in [k for k, fact in facts.items() if k[1] == job and void(fact)]:
+            for key in [k for k, fact in facts.items() if k[1] == job and stale(fact)]:
                 del facts[key]
-        if job in self._job_done and void(self._job_done[job]):
+        if job in self._job_done and stale(self._job_done[job]):
             del self._job_done[job]
 
     # --- facts reported by the others ------------------------------------------------
@@ -293,13 +294,13 @@ class RobotExecution:
 
     def aborted(self, job: str, revision: int) -> bool:
         """The job will be redone from scratch: what was reported about it no longer holds."""
-        if revision < self._restarted.get(job, 0):
+        if self._restarts.void(job, revision):
             return False
         self._forget(job, lambda fact: fact.revision <= revision)
         return True
 
     def _record(self, facts, key, job: str, time: float, revision: int) -> bool:
-        if revision < self._restarted.get(job, 0):
+        if self._restarts.void(job, revision):
             return False
         # Of two reports of the same fact the first counts, unless the other one comes from a
         # newer revision (a robot redoing a restarted job may report before this robot

@@ -10,20 +10,19 @@ from fractions import Fraction
 import pytest
 
 from fjsp_common.vocabulary import EventKind, MissionEventKind, MissionState, RobotMode
-from fjsp_planner.execution.mission.controller import (
-    DUE_GRACE,
-    IMPROVE_REACH,
-    PLAN_RESEND_AFTER,
-    EventReport,
+from fjsp_planner.execution.mission.continuation import DUE_GRACE
+from fjsp_planner.execution.mission.controller import IMPROVE_REACH, MissionController
+from fjsp_planner.execution.mission.effects import (
     JobDone,
-    MissionController,
     Note,
     PublishPlan,
     ResendPlan,
-    RobotReport,
-    Settings,
     Solve,
+    SolveKind,
 )
+from fjsp_planner.execution.mission.liveness import PLAN_RESEND_AFTER
+from fjsp_planner.execution.mission.reports import EventReport, RobotReport
+from fjsp_planner.execution.mission.settings import Settings
 from fjsp_planner.execution.replan import Improvement, Replan, improve, repair
 from fjsp_planner.model.scenario import load_scenario
 from fjsp_planner.model.schedule import Schedule
@@ -109,11 +108,12 @@ class Fleet:
         with `improve_too`); the effects of their outcomes."""
         out = []
         for effect in list(self.effects if effects is None else effects):
-            if not isinstance(effect, Solve) or (effect.kind == 'improve' and not improve_too):
+            if not isinstance(effect, Solve) or (effect.kind == SolveKind.IMPROVE
+                                                 and not improve_too):
                 continue
-            if effect.kind == 'plan':
+            if effect.kind == SolveKind.PLAN:
                 outcome = solve(effect.problem, time_limit=effect.time_limit)
-            elif effect.kind == 'repair':
+            elif effect.kind == SolveKind.REPAIR:
                 outcome = repair(effect.problem, effect.previous, effect.state,
                                  time_limit=effect.time_limit)
             else:
@@ -188,7 +188,7 @@ def test_first_plan_waits_for_every_robot_then_solves_the_scenario(problem):
     assert not kinds(fleet.tick(robots=ROBOTS[:3]), Solve)
     fleet.heartbeat()
     (request,) = kinds(fleet.tick(), Solve)
-    assert request.kind == 'plan' and request.problem is problem  # nothing moved: as given
+    assert request.kind == SolveKind.PLAN and request.problem is problem  # nothing moved: as given
     assert fleet.state() == MissionState.PLANNING
     (published,) = kinds(fleet.run_solves(), PublishPlan)
     assert published.revision == 1 and published.result.makespan == 32
@@ -231,7 +231,7 @@ def test_failure_replans_without_the_robot(problem):
     effects = fleet.report('MARC1', RobotMode.FAILED)
     assert notes(effects, MissionEventKind.ROBOT_FAILED)
     (request,) = kinds(fleet.tick(), Solve)
-    assert request.kind == 'repair' and "robot 'MARC1' failed" in request.reasons
+    assert request.kind == SolveKind.REPAIR and "robot 'MARC1' failed" in request.reasons
     assert not request.state.robots['MARC1'].healthy
     (published,) = kinds(fleet.run_solves(), PublishPlan)
     assert published.revision == 2 and 'MARC1' not in published.result.schedule.sequences
@@ -827,7 +827,7 @@ def repaired_after_a_failure(problem):
 
 def test_a_repaired_plan_is_published_at_once_then_bettered(problem):
     fleet, repaired, effects = repaired_after_a_failure(problem)
-    searches = [e for e in kinds(effects, Solve) if e.kind == 'improve']
+    searches = [e for e in kinds(effects, Solve) if e.kind == SolveKind.IMPROVE]
     if repaired.result.status == 'optimal':
         assert not searches  # nothing to better
         return
@@ -849,13 +849,13 @@ def test_a_better_plan_is_searched_from_again_until_a_search_finds_no_better(pro
     """The searches' outcomes are made up (the repaired plan, said to be better), so that
     both turns are taken whatever CP-SAT would find."""
     fleet, repaired, effects = repaired_after_a_failure(problem)
-    (search,) = [e for e in kinds(effects, Solve) if e.kind == 'improve']
+    (search,) = [e for e in kinds(effects, Solve) if e.kind == SolveKind.IMPROVE]
     published = search.published
     effects = fleet.take(fleet.controller.solved(search.token, Improvement(published, True),
                                                  fleet.wall))
     (better,) = kinds(effects, PublishPlan)
     assert better.revision == repaired.revision + 1
-    (again,) = [e for e in kinds(effects, Solve) if e.kind == 'improve']
+    (again,) = [e for e in kinds(effects, Solve) if e.kind == SolveKind.IMPROVE]
     assert again.published is published and again.token != search.token
     assert again.time_limit == search.time_limit == SETTINGS.replan_time_limit
     # Searches that find nothing better double in length, up to 16 re-plan limits.
@@ -864,7 +864,7 @@ def test_a_better_plan_is_searched_from_again_until_a_search_finds_no_better(pro
         effects = fleet.take(fleet.controller.solved(again.token,
                                                      Improvement(published, False), fleet.wall))
         assert not kinds(effects, PublishPlan)
-        searches = [e for e in kinds(effects, Solve) if e.kind == 'improve']
+        searches = [e for e in kinds(effects, Solve) if e.kind == SolveKind.IMPROVE]
         if not searches:
             break
         (again,) = searches
@@ -878,7 +878,7 @@ def test_a_better_plan_that_changes_what_the_robots_started_meanwhile_is_dropped
     warning, and a search twice as long starts from the published plan. The search's
     outcome is made up so that it does change such a job."""
     fleet, repaired, effects = repaired_after_a_failure(problem)
-    (search,) = [e for e in kinds(effects, Solve) if e.kind == 'improve']
+    (search,) = [e for e in kinds(effects, Solve) if e.kind == SolveKind.IMPROVE]
     published = search.published
     fleet.wall += 10
     fleet.execute(until=12)
@@ -898,7 +898,7 @@ def test_a_better_plan_that_changes_what_the_robots_started_meanwhile_is_dropped
     assert not kinds(effects, PublishPlan)
     (warning,) = notes(effects, MissionEventKind.WARNING)
     assert 'dropped' in warning.reasons[0] and f"job '{moved}'" in warning.reasons[0]
-    (again,) = [e for e in kinds(effects, Solve) if e.kind == 'improve']
+    (again,) = [e for e in kinds(effects, Solve) if e.kind == SolveKind.IMPROVE]
     assert again.published is published
     assert again.time_limit == 2 * search.time_limit
     assert moved in again.started
@@ -910,9 +910,225 @@ def test_a_search_for_a_better_plan_is_dropped_when_the_fleet_changes(problem):
     fleet.report('MARC1', RobotMode.FAILED)
     (repair_request,) = kinds(fleet.tick(), Solve)
     searches = [e for e in kinds(fleet.run_solves([repair_request]), Solve)
-                if e.kind == 'improve']
+                if e.kind == SolveKind.IMPROVE]
     fleet.failures['MARC2'] += 1
     fleet.report('MARC2', RobotMode.FAILED)
     assert kinds(fleet.tick(), Solve)  # a new repair for the second failure
     for search in searches:
         assert not fleet.run_solves([search], improve_too=True)
+
+
+# --- moves of the mission state the tests above do not make (states.TRANSITIONS) ---------
+
+def test_a_mission_waiting_for_robots_can_be_cancelled(problem):
+    fleet = Fleet(problem)
+    fleet.start()
+    effects = fleet.take(fleet.controller.cancel('operator stop', fleet.wall))
+    assert fleet.state() == MissionState.CANCELLED
+    assert notes(effects, MissionEventKind.MISSION_CANCELLED)
+    assert not kinds(effects, PublishPlan)  # no plan was ever published: nothing to revoke
+
+
+def test_a_mission_cancelled_while_its_first_plan_is_solved_publishes_no_plan(problem):
+    fleet = Fleet(problem)
+    fleet.start()
+    request = fleet.tick_until_solve()
+    fleet.take(fleet.controller.cancel('operator stop', fleet.wall))
+    assert not fleet.run_solves([request])
+    assert fleet.state() == MissionState.CANCELLED
+
+
+def test_a_mission_cancelled_while_it_is_replanned_publishes_only_the_cancelling_plan(problem):
+    fleet = executing(problem)
+    fleet.failures['MARC1'] += 1
+    fleet.report('MARC1', RobotMode.FAILED)
+    (request,) = kinds(fleet.tick(), Solve)
+    assert fleet.state() == MissionState.REPLANNING
+    (cancelling,) = kinds(fleet.take(fleet.controller.cancel('operator stop', fleet.wall)),
+                          PublishPlan)
+    assert cancelling.cancelled and cancelling.revision == 2
+    assert not fleet.run_solves([request])
+    assert fleet.state() == MissionState.CANCELLED
+
+
+def test_a_blocked_mission_can_be_cancelled(problem):
+    fleet = executing(problem)
+    for robot in ('MARC1', 'MARC2'):
+        fleet.failures[robot] += 1
+        fleet.report(robot, RobotMode.FAILED)
+    fleet.tick()
+    fleet.run_solves()
+    assert fleet.state() == MissionState.BLOCKED
+    fleet.take(fleet.controller.cancel('operator stop', fleet.wall))
+    assert fleet.state() == MissionState.CANCELLED
+    assert fleet.status().blocked == ('operator stop',)
+
+
+def test_a_first_plan_the_solver_cannot_make_fails_the_mission(problem):
+    fleet = Fleet(problem)
+    fleet.start()
+    request = fleet.tick_until_solve()
+    effects = fleet.take(fleet.controller.solved(request.token, ValueError('out of memory'),
+                                                 fleet.wall))
+    assert notes(effects, MissionEventKind.MISSION_FAILED)
+    assert fleet.state() == MissionState.FAILED
+    assert fleet.status().blocked == ('solver: out of memory',)
+
+
+def test_jobs_added_while_the_first_plan_is_solved_are_in_the_first_plan(problem):
+    from fjsp_planner.model.extension import extend
+
+    fleet = Fleet(problem)
+    fleet.start()
+    before = fleet.tick_until_solve()
+    extended, added = extend(problem, 'jobs: [{name: Inspect, location: Ad, plans: '
+                             '[[locomote]]}]\nprecedence: [[Ad, Inspect]]\n')
+    (request,) = kinds(fleet.take(fleet.controller.add_jobs(extended, added, fleet.wall)),
+                       Solve)
+    assert request.kind == SolveKind.PLAN and 'Inspect' in {j.name for j in request.problem.jobs}
+    assert fleet.state() == MissionState.PLANNING
+    assert not fleet.run_solves([before])  # it left the new job out
+    (published,) = kinds(fleet.run_solves([request]), PublishPlan)
+    assert published.revision == 1 and 'Inspect' in published.result.schedule.jobs
+
+
+def test_a_mission_blocked_before_its_first_plan_is_planned_once_robots_come_back(problem):
+    fleet = Fleet(problem)
+    fleet.start()
+    for robot in ('MARC1', 'MARC2'):
+        fleet.failures[robot] += 1
+        fleet.modes[robot] = RobotMode.FAILED
+    fleet.tick()
+    assert fleet.state() == MissionState.BLOCKED
+    blocked = fleet.status().blocked
+    assert "robot 'MARC1' failed" in blocked and "robot 'MARC2' failed" in blocked
+    # The Assembler fails too: still blocked, for more reasons.
+    fleet.failures['Assembler'] += 1
+    fleet.report('Assembler', RobotMode.FAILED)
+    fleet.tick()
+    assert fleet.state() == MissionState.BLOCKED
+    assert "robot 'Assembler' failed" in fleet.status().blocked
+    for robot in ('Assembler', 'MARC1'):
+        fleet.report(robot, RobotMode.IDLE)
+    (request,) = kinds(fleet.tick(), Solve)
+    assert request.kind == SolveKind.PLAN
+    assert fleet.state() == MissionState.PLANNING
+    (published,) = kinds(fleet.run_solves([request]), PublishPlan)
+    assert published.revision == 1 and 'MARC2' not in published.result.schedule.sequences
+
+
+def all_but_one_operation_done(fleet):
+    """Report the plan executed to plan but for one operation of its last job; (the robot
+    that still works on it, the job, its operation's end)."""
+    plan, problem = fleet.controller.mission.schedule, fleet.problem
+    order = sorted(plan.jobs, key=lambda name: (plan.jobs[name].start, name))
+    last, working = order[-1], next(iter(plan.jobs[order[-1]].robots))
+    for name in order:
+        a = plan.jobs[name]
+        for robot in a.robots:
+            fleet.event(EventKind.STARTED, robot, name, float(a.start))
+        for robot, q in a.robots.items():
+            if (name, robot) != (last, working):
+                fleet.event(EventKind.OPERATION_DONE, robot, name,
+                            float(a.start + problem.duration(robot, q)))
+    a = plan.jobs[last]
+    return working, last, float(a.start + problem.duration(working, a.robots[working]))
+
+
+def test_a_mission_whose_last_job_ends_while_it_is_replanned_completes(problem):
+    fleet = executing(problem)
+    working, last, end = all_but_one_operation_done(fleet)
+    assert fleet.controller.mission.tracker.done == {j.name for j in problem.jobs} - {last}
+    idle = next(r for r in ROBOTS if r not in fleet.controller.mission.schedule.jobs[last].robots)
+    fleet.failures[idle] += 1
+    fleet.report(idle, RobotMode.FAILED)
+    (request,) = kinds(fleet.tick(), Solve)
+    assert fleet.state() == MissionState.REPLANNING
+    fleet.event(EventKind.OPERATION_DONE, working, last, end)
+    assert fleet.state() == MissionState.COMPLETE
+    assert not fleet.run_solves([request])
+
+
+def test_an_invalid_executed_timeline_fails_the_mission_while_it_is_replanned(problem):
+    fleet = executing(problem)
+    fleet.failures['MARC1'] += 1
+    fleet.report('MARC1', RobotMode.FAILED)
+    fleet.tick()
+    assert fleet.state() == MissionState.REPLANNING
+    for name, a in fleet.controller.mission.schedule.jobs.items():
+        for robot in a.robots:
+            fleet.event(EventKind.STARTED, robot, name, 0.0)
+            fleet.event(EventKind.OPERATION_DONE, robot, name, 1.0)
+    assert fleet.state() == MissionState.FAILED
+    assert any('executed timeline' in r for r in fleet.status().blocked)
+
+
+def resumed_with_the_histories_on_their_way(problem, last_events):
+    """Revision 1 of the paper's mission published, then the planner restarted: a new
+    controller resumed from the journal, whose robots report following revision 1 and having
+    published `last_events` (robot -> event id), not received yet; (the fleet, the plan)."""
+    from fjsp_planner.execution.journal import PlanRecord
+
+    fleet = executing(problem)
+    first = kinds(fleet.effects, PublishPlan)[0]
+    records = [PlanRecord(1, first.mission_start, first.result.schedule, frozenset(), ())]
+    restarted = Fleet(problem)
+    restarted.wall = fleet.wall + 1
+    restarted.take(restarted.controller.resume('m1', problem, SETTINGS, fleet.wall, records,
+                                               restarted.wall))
+    restarted.following = {'mission_id': 'm1', 'revision': 1}
+    for robot in ROBOTS:
+        restarted.report(robot, last_event=last_events.get(robot, ''))
+    restarted.take(restarted.controller.tick(restarted.wall))
+    assert restarted.state() == MissionState.WAITING_FOR_ROBOTS
+    return restarted, first.result.schedule
+
+
+def history_of(restarted, plan, time=None):
+    """The robots' event histories of `plan` arrive: every job done to plan, or all at once
+    from `time` to `time + 1`; the id of each robot's last event."""
+    problem, last = restarted.problem, {}
+    for name, a in sorted(plan.jobs.items(), key=lambda kv: kv[1].start):
+        for robot, q in a.robots.items():
+            start = float(a.start) if time is None else time
+            end = float(a.start + problem.duration(robot, q)) if time is None else time + 1
+            for kind, at in ((EventKind.STARTED, start), (EventKind.OPERATION_DONE, end)):
+                restarted.events += 1
+                last[robot] = f'{robot}/{restarted.events}'
+                restarted.take(restarted.controller.task_event(EventReport(
+                    last[robot], 'm1', kind, robot, name, 1, at), restarted.wall)[0])
+    return last
+
+
+def test_a_mission_its_robots_finished_while_no_planner_ran_completes_on_their_reports(problem):
+    """A planner killed for the whole mission, then started again: the robots finished the
+    plan they had, and their histories complete the mission before any re-plan."""
+    restarted, plan = resumed_with_the_histories_on_their_way(problem, dict.fromkeys(
+        ROBOTS, 'on/its/way'))
+    history_of(restarted, plan)
+    assert restarted.state() == MissionState.COMPLETE
+    assert notes(restarted.effects, MissionEventKind.MISSION_COMPLETE)
+
+
+def test_a_resumed_mission_whose_histories_break_the_timeline_fails(problem):
+    restarted, plan = resumed_with_the_histories_on_their_way(problem, dict.fromkeys(
+        ROBOTS, 'on/its/way'))
+    history_of(restarted, plan, time=0.0)
+    assert restarted.state() == MissionState.FAILED
+    assert any('executed timeline' in r for r in restarted.status().blocked)
+
+
+def test_an_execution_state_the_tracker_cannot_tell_blocks_the_mission(problem):
+    fleet = executing(problem)
+    tracker = fleet.controller.mission.tracker
+
+    def contradiction(now):
+        raise ValueError("job 'Ja' ends before it starts")
+
+    tracker.execution_state = contradiction
+    fleet.failures['MARC1'] += 1
+    fleet.report('MARC1', RobotMode.FAILED)
+    assert not kinds(fleet.tick(), Solve)
+    assert fleet.state() == MissionState.BLOCKED
+    assert fleet.status().blocked == (
+        "cannot tell the execution state: job 'Ja' ends before it starts",)

@@ -16,14 +16,10 @@ import pytest
 
 from fjsp_common.vocabulary import EventKind, MissionState, RobotMode
 from fjsp_planner.execution.journal import PlanRecord
-from fjsp_planner.execution.mission.controller import (
-    EventReport,
-    MissionController,
-    PublishPlan,
-    RobotReport,
-    Settings,
-    Solve,
-)
+from fjsp_planner.execution.mission.controller import MissionController
+from fjsp_planner.execution.mission.effects import PublishPlan, Solve, SolveKind
+from fjsp_planner.execution.mission.reports import EventReport, RobotReport
+from fjsp_planner.execution.mission.settings import Settings
 from fjsp_planner.execution.replan import replan
 from fjsp_planner.execution.tracking import MissionTracker
 from fjsp_planner.model.scenario import load_scenario
@@ -70,7 +66,7 @@ class Planner:
         pending, self.solves = self.solves, []
         for request in pending:
             try:
-                if request.kind == 'plan':
+                if request.kind == SolveKind.PLAN:
                     outcome = solve(request.problem, time_limit=request.time_limit)
                 else:
                     outcome = replan(request.problem, request.previous, request.state,

@@ -51,7 +51,10 @@ class StateError(ValueError):
 
 
 @dataclass(frozen=True)
-class RobotState:
+class RobotSituation:
+    """Where a robot stands as re-planning starts: whether it can work, where and from when.
+    (Not the `RobotState` message, from which the tracker derives it.)"""
+
     name: str
     healthy: bool
     location: str | None
@@ -69,7 +72,7 @@ class ExecutionState:
     """Jobs completed."""
     running: Mapping[str, JobAssignment]
     """Jobs in progress: actual start, plan and robots; `end` is the expected end."""
-    robots: Mapping[str, RobotState]
+    robots: Mapping[str, RobotSituation]
     """Every robot of the problem, by name."""
     done_as: Mapping[str, JobAssignment] = field(default_factory=dict)
     """How completed jobs were done, where known: their plan, robots and actual times. A
@@ -621,7 +624,7 @@ def simulated_state(problem: Problem, schedule: Schedule, now: Fraction,
             elif location is not None and visit.travel_start <= now:
                 location, free_at = here, visit.arrival
             break
-        robots[robot.name] = RobotState(robot.name, robot.name not in failed, location,
+        robots[robot.name] = RobotSituation(robot.name, robot.name not in failed, location,
                                         max(now, free_at),
                                         now if robot.name in failed else None)
     done_as = {name: a for name, a in schedule.jobs.items() if name in finished}

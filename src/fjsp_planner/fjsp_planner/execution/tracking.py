@@ -20,8 +20,9 @@ from dataclasses import dataclass, field
 from enum import StrEnum
 from fractions import Fraction
 
+from fjsp_common.revisions import void
 from fjsp_common.vocabulary import EventKind, RobotMode
-from fjsp_planner.execution.replan import ExecutionState, RobotState
+from fjsp_planner.execution.replan import ExecutionState, RobotSituation
 from fjsp_planner.model.limits import shown
 from fjsp_planner.model.problem import Problem
 from fjsp_planner.model.schedule import JobAssignment, Schedule
@@ -93,8 +94,8 @@ class RobotRecord:
 
 
 @dataclass(frozen=True)
-class Outcome:
-    """The result of one report: ignored (with why), or used; maybe completing a job."""
+class Verdict:
+    """What became of one report: ignored (with why), or used; maybe completing a job."""
 
     ignored: Ignored | None = None
     reason: str = ''
@@ -165,7 +166,7 @@ class MissionTracker:
     # --- reports -----------------------------------------------------------------------
 
     def record_event(self, event_id: str, kind: EventKind, robot: str, job: str,
-                     revision: int, time: float) -> Outcome:
+                     revision: int, time: float) -> Verdict:
         """Use one task event of an agent; classify it if it cannot be used. Never raises,
         whatever the arguments."""
         outcome = self._check_event(event_id, kind, robot, job, revision, time)
@@ -182,12 +183,12 @@ class MissionTracker:
                  EventKind.OPERATION_DONE: record.operation_done}
         if kind == EventKind.ABORTED:
             if record.end is not None:
-                return Outcome()
+                return Verdict()
             self.jobs[job] = JobRecord(job, since_revision=record.since_revision, aborted=True)
-            return Outcome()
+            return Verdict()
         if robot in facts[kind] or record.end is not None:
             self.ignored[Ignored.DUPLICATE] += 1
-            return Outcome(Ignored.DUPLICATE, f"'{robot}' already reported {kind} for job "
+            return Verdict(Ignored.DUPLICATE, f"'{robot}' already reported {kind} for job "
                                               f"'{job}' (event {shown(event_id)})")
         facts[kind][robot] = time
         if kind == EventKind.OPERATION_DONE:
@@ -197,57 +198,57 @@ class MissionTracker:
                 planned = self.plan.jobs[job]
                 record.done_as = JobAssignment(job, planned.plan, Fraction(record.start),
                                                Fraction(record.end), dict(robots))
-                return Outcome(job_done=(job, record.end))
-        return Outcome()
+                return Verdict(job_done=(job, record.end))
+        return Verdict()
 
-    def _check_event(self, event_id, kind, robot, job, revision, time) -> Outcome | None:
+    def _check_event(self, event_id, kind, robot, job, revision, time) -> Verdict | None:
         if not isinstance(event_id, str):
-            return Outcome(Ignored.UNKNOWN, f'invalid event id {shown(event_id)}')
+            return Verdict(Ignored.UNKNOWN, f'invalid event id {shown(event_id)}')
         what = f'event {shown(event_id)}'      # an id of a megabyte is not logged whole
         if self.plan is None:
-            return Outcome(Ignored.STALE, f'{what} arrived before any plan')
+            return Verdict(Ignored.STALE, f'{what} arrived before any plan')
         if event_id in self._event_ids:
-            return Outcome(Ignored.DUPLICATE, f'{what} was already received')
+            return Verdict(Ignored.DUPLICATE, f'{what} was already received')
         if not isinstance(kind, str) or kind not in ROBOT_EVENTS:
-            return Outcome(Ignored.UNKNOWN, f'{what} has unknown event kind '
+            return Verdict(Ignored.UNKNOWN, f'{what} has unknown event kind '
                                             f'{shown(kind)}')
         if not isinstance(robot, str) or robot not in self.robots:
-            return Outcome(Ignored.UNKNOWN, f'{what} names unknown robot '
+            return Verdict(Ignored.UNKNOWN, f'{what} names unknown robot '
                                             f'{shown(robot)}')
         if not isinstance(job, str) or job not in self.jobs:
-            return Outcome(Ignored.UNKNOWN, f'{what} names unknown job '
+            return Verdict(Ignored.UNKNOWN, f'{what} names unknown job '
                                             f'{shown(job)}')
         if isinstance(revision, bool) or not isinstance(revision, int):
-            return Outcome(Ignored.UNKNOWN, f'{what} has invalid plan revision '
+            return Verdict(Ignored.UNKNOWN, f'{what} has invalid plan revision '
                                             f'{shown(revision)}')
         if revision > self.revision:
-            return Outcome(Ignored.UNKNOWN, f'{what} follows plan revision '
+            return Verdict(Ignored.UNKNOWN, f'{what} follows plan revision '
                                             f'{revision}, which was never published '
                                             f'(current: {self.revision})')
-        if revision < self.jobs[job].since_revision:
-            return Outcome(Ignored.STALE, f"{what} follows plan revision "
+        if void(revision, self.jobs[job].since_revision):
+            return Verdict(Ignored.STALE, f"{what} follows plan revision "
                                           f"{revision}; revision "
                                           f'{self.jobs[job].since_revision} started '
                                           f"'{job}' afresh")
         if self.jobs[job].aborted:
-            return Outcome(Ignored.STALE, f"{what}: job '{job}' was aborted and "
+            return Verdict(Ignored.STALE, f"{what}: job '{job}' was aborted and "
                                           'waits for a new revision to be redone')
         if job not in self.plan.jobs:
-            return Outcome(Ignored.STALE, f"{what}: job '{job}' is not in plan "
+            return Verdict(Ignored.STALE, f"{what}: job '{job}' is not in plan "
                                           f'revision {self.revision}, it was done before')
         if robot not in self.plan.jobs[job].robots:
             if revision < self.revision:
-                return Outcome(Ignored.STALE, f"{what} follows plan revision "
+                return Verdict(Ignored.STALE, f"{what} follows plan revision "
                                               f'{revision}; in revision {self.revision} '
                                               f"'{robot}' has no part in job '{job}'")
-            return Outcome(Ignored.UNKNOWN, f"{what}: robot '{robot}' has no "
+            return Verdict(Ignored.UNKNOWN, f"{what}: robot '{robot}' has no "
                                             f"part in job '{job}'")
         if not _time_ok(time):
-            return Outcome(Ignored.UNKNOWN, f'{what} has invalid time '
+            return Verdict(Ignored.UNKNOWN, f'{what} has invalid time '
                                             f'{shown(time)}')
         return None
 
-    def _check_order(self, event_id, kind, robot, job, time) -> Outcome | None:
+    def _check_order(self, event_id, kind, robot, job, time) -> Verdict | None:
         """An operation reported done must have been reported started, and not later: the
         job's timeline is built from both (a forged event, or the history of an earlier
         planner arriving after this one's first plan, can break this)."""
@@ -256,18 +257,18 @@ class MissionTracker:
         what = f'event {shown(event_id)}'
         started = self.jobs[job].started.get(robot)
         if started is None:
-            return Outcome(Ignored.UNKNOWN, f"{what}: '{robot}' reports "
+            return Verdict(Ignored.UNKNOWN, f"{what}: '{robot}' reports "
                                             f"operation_done for job '{job}' without having "
                                             'reported started')
         if time < started:
-            return Outcome(Ignored.UNKNOWN, f"{what}: '{robot}' reports "
+            return Verdict(Ignored.UNKNOWN, f"{what}: '{robot}' reports "
                                             f'operation_done at t={float(time):g} before it '
                                             f"started at t={float(started):g} (job '{job}')")
         return None
 
     def record_robot_state(self, robot: str, mode: str, location: str, destination: str,
                            busy_until: float, current_job: str = '',
-                           at: float | None = None) -> Outcome:
+                           at: float | None = None) -> Verdict:
         """Use a robot's state report (or heartbeat) observed at schedule time `at`.
 
         A report that turns a healthy robot failed or offline counts a failure at `at` (by
@@ -281,7 +282,7 @@ class MissionTracker:
             if not repeated:
                 self._repeated.add(problem)
                 self.ignored[Ignored.UNKNOWN] += 1
-            return Outcome(Ignored.UNKNOWN, problem, repeated=repeated)
+            return Verdict(Ignored.UNKNOWN, problem, repeated=repeated)
         record = self.robots[robot]
         was_healthy = record.healthy
         # A robot does not leave its place by restarting its agent, whose new process
@@ -291,7 +292,7 @@ class MissionTracker:
         record.busy_until = busy_until if _time_ok(busy_until) else math.nan
         record.current_job, record.reported = current_job, True
         self._count_failure(record, was_healthy, at)
-        return Outcome()
+        return Verdict()
 
     def _state_problem(self, robot, mode, location, destination, current_job) -> str | None:
         if not isinstance(robot, str) or robot not in self.robots:
@@ -306,16 +307,16 @@ class MissionTracker:
                 return f"'{robot}' reports unknown {what} {shown(value)}"
         return None
 
-    def mark_offline(self, robot: str, at: float | None = None) -> Outcome:
+    def mark_offline(self, robot: str, at: float | None = None) -> Verdict:
         """Its heartbeat was lost (observed at schedule time `at`): treated as failed until it
         reports again. Counts a failure like `record_robot_state`."""
         if not isinstance(robot, str) or robot not in self.robots:
-            return Outcome(Ignored.UNKNOWN, f'heartbeat loss of unknown robot {shown(robot)}')
+            return Verdict(Ignored.UNKNOWN, f'heartbeat loss of unknown robot {shown(robot)}')
         record = self.robots[robot]
         was_healthy = record.healthy
         record.mode = RobotMode.OFFLINE
         self._count_failure(record, was_healthy, at)
-        return Outcome()
+        return Verdict()
 
     def agent_restarted(self, robot: str, at: float | None = None) -> list[str]:
         """The robot's agent restarted (observed at schedule time `at`): the operations its
@@ -485,7 +486,7 @@ class MissionTracker:
             # Nor is it free before its release time, however idle it looks.
             free_at = max(free_at, Fraction(robot.release_time))
             failed_at = None if r.last_failure_at is None else Fraction(r.last_failure_at)
-            robots[name] = RobotState(name, r.healthy, location, free_at, failed_at)
+            robots[name] = RobotSituation(name, r.healthy, location, free_at, failed_at)
         done_as = {name: self.jobs[name].done_as for name in self.done
                    if self.jobs[name].done_as is not None}
         return ExecutionState(now_f, self.done, running, robots, done_as)

@@ -24,7 +24,7 @@ from pathlib import Path
 from ament_index_python.packages import get_package_prefix
 
 from fjsp_common.auth import KEY_FILE_VARIABLE, new_key
-from fjsp_common.contract import agent_node_name
+from fjsp_common.fleet import MONITOR_NODE, PLANNER_NODE, RECORDER_NODE, agent_node_name
 from fjsp_planner.launcher.params import (
     read_params_file,
     ros_string,
@@ -35,9 +35,6 @@ from fjsp_planner.model.problem import Problem, ProblemError
 from fjsp_planner.model.scenario import load_scenario
 from fjsp_planner.workspace import default_out_dir, installed_scenarios
 
-PLANNER_NODE = 'planner'
-MONITOR_NODE = 'monitor'
-RECORDER_NODE = 'recorder'
 MONITOR_OUT_PARAMETER = 'out_dir'
 """The monitor's parameter naming the directory its outputs go to."""
 DEFAULT_SCENARIO = 'solar_panel.yaml'

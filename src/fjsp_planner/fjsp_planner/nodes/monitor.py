@@ -15,29 +15,31 @@ import sys
 import time
 from pathlib import Path
 
-from diagnostic_msgs.msg import DiagnosticArray
 from rclpy.node import Node
 
-from fjsp_common.auth import PLANNER, NodeAuth
+from fjsp_common.auth import NodeAuth
 from fjsp_common.contract import (
-    EVENTS_QOS,
-    LATCHED_QOS,
-    MISSION_EVENTS_TOPIC,
-    MISSION_STATUS_TOPIC,
-    PLAN_TOPIC,
-    ROBOT_STATES_QOS,
-    ROBOT_STATES_TOPIC,
-    TASK_EVENTS_TOPIC,
+    DIAGNOSTICS,
+    MISSION_EVENTS,
+    MISSION_STATUS,
+    PLAN,
+    ROBOT_STATES,
+    TASK_EVENTS,
+    publisher,
+    subscription,
 )
-from fjsp_common.diagnostics import (
-    DIAGNOSTICS_QOS,
-    DIAGNOSTICS_TOPIC,
-    diagnostic_array,
-    robot_diagnostic,
+from fjsp_common.diagnostics import diagnostic_array, robot_diagnostic
+from fjsp_common.fleet import (
+    DIAGNOSTICS_PERIOD,
+    HEARTBEAT_TIMEOUT,
+    LATE_THRESHOLD,
+    MONITOR_NODE,
+    PLANNER_NODE,
 )
+from fjsp_common.parameters import ParameterSpec, table
 from fjsp_common.running import declare, run_node, shorten
 from fjsp_common.vocabulary import RobotMode
-from fjsp_msgs.msg import MissionEvent, MissionStatus, Plan, RobotState, TaskEvent
+from fjsp_msgs.msg import MissionEvent, MissionStatus, RobotState, TaskEvent
 from fjsp_planner.observe import text, views
 from fjsp_planner.observe.dashboard import Dashboard
 from fjsp_planner.observe.facts import Decoder, UnreadableMessageError
@@ -49,6 +51,31 @@ DECODER = Decoder.from_classes(RobotState, TaskEvent, MissionStatus, MissionEven
 TIMELINE_PERIOD = 1.0
 """Seconds between page updates when only the clock moved (offline robots, the timeline)."""
 
+PARAMETERS = table(
+    ParameterSpec('out_dir', '', "directory of the Gantt charts and histories; empty: the "
+                  "workspace's out/ (else ~/.ros/fjsp/out)"),
+    ParameterSpec('refresh_period', 1.0, 'seconds between checks for a new frame of the log '
+                  'view', low=0.05, high=60.0),
+    ParameterSpec('heartbeat_timeout', HEARTBEAT_TIMEOUT,
+                  'seconds without a robot state before the robot shows offline', low=0.05,
+                  high=600.0),
+    ParameterSpec('exit_on_complete', False, 'exit once a mission has ended and is drawn'),
+    # Events may reach a late joiner after the status saying the mission ended.
+    ParameterSpec('event_grace', 3.0, 'seconds to wait for late events once a mission ended '
+                  'before drawing it', low=0.0, high=600.0),
+    ParameterSpec('web_port', 8080, 'port of the live web page; 0: no web page', low=0,
+                  high=65535),
+    ParameterSpec('web_host', '127.0.0.1',
+                  'address the web page is served on (0.0.0.0: every interface)'),
+    ParameterSpec('web_period', 0.1, 'seconds between checks for changes to push to the web '
+                  'page', low=0.02, high=10.0),
+    ParameterSpec('diagnostics_period', DIAGNOSTICS_PERIOD,
+                  'seconds between per-robot diagnostics on /diagnostics', low=0.1, high=60.0),
+    ParameterSpec('late_threshold', LATE_THRESHOLD, "schedule units a robot's operation may run "
+                  'past its plan before its diagnostic is WARN', low=0.0, high=1e6),
+)
+"""The monitor's parameters, in the order it declares them."""
+
 
 def senders_of(msg) -> set[str]:
     """Who may have signed `msg`: the robot it is about, or the planner."""
@@ -56,46 +83,21 @@ def senders_of(msg) -> set[str]:
         return {msg.robot}
     if isinstance(msg, TaskEvent) and msg.kind != TaskEvent.KIND_JOB_DONE:
         return {msg.robot}
-    return {PLANNER}
+    return {PLANNER_NODE}
 
 
 class MonitorNode(Node):
     def __init__(self):
-        super().__init__('monitor')
-        out_dir = declare(self, 'out_dir', '',
-                          "directory of the Gantt charts and histories; empty: the workspace's "
-                          'out/ (else ~/.ros/fjsp/out)')
+        super().__init__(MONITOR_NODE)
+        value = {name: declare(self, spec) for name, spec in PARAMETERS.items()}
+        out_dir = value['out_dir']
         self.out_dir = Path(out_dir).expanduser() if out_dir else default_out_dir()
-        refresh_period = declare(self, 'refresh_period', 1.0,
-                                 'seconds between checks for a new frame of the log view',
-                                 low=0.05, high=60.0)
-        heartbeat_timeout = declare(
-            self, 'heartbeat_timeout', 1.0,
-            'seconds without a robot state before the robot shows offline', low=0.05,
-            high=600.0)
-        self.exit_on_complete = declare(self, 'exit_on_complete', False,
-                                        'exit once a mission has ended and is drawn')
-        # Events may reach a late joiner after the status saying the mission ended.
-        self.event_grace = declare(
-            self, 'event_grace', 3.0,
-            'seconds to wait for late events once a mission ended before drawing it',
-            low=0.0, high=600.0)
-        web_port = declare(self, 'web_port', 8080,
-                           'port of the live web page; 0: no web page', low=0, high=65535)
-        web_host = declare(self, 'web_host', '127.0.0.1',
-                           'address the web page is served on (0.0.0.0: every interface)')
-        web_period = declare(self, 'web_period', 0.1,
-                             'seconds between checks for changes to push to the web page',
-                             low=0.02, high=10.0)
-        diagnostics_period = declare(
-            self, 'diagnostics_period', 1.0,
-            'seconds between per-robot diagnostics on /diagnostics', low=0.1, high=60.0)
-        self.late_threshold = declare(
-            self, 'late_threshold', 2.0,
-            "schedule units a robot's operation may run past its plan before its diagnostic "
-            'is WARN', low=0.0, high=1e6)
+        self.exit_on_complete = value['exit_on_complete']
+        self.event_grace = value['event_grace']
+        self.late_threshold = value['late_threshold']
+        web_port, web_host = value['web_port'], value['web_host']
 
-        self.fleet = FleetHistory(heartbeat_timeout)
+        self.fleet = FleetHistory(value['heartbeat_timeout'])
         self.told: set[tuple[str, str]] = set()
         """(mission, story key) of every line already logged."""
         self.frame_key = None
@@ -116,20 +118,14 @@ class MonitorNode(Node):
                     f'no live web page: cannot serve on {web_host}:{web_port} '
                     f'({error.strerror or error}); set web_port to a free port, or 0')
 
-        self.auth = NodeAuth(self, 'monitor')
-        for msg_type, topic, qos in ((Plan, PLAN_TOPIC, LATCHED_QOS),
-                                     (RobotState, ROBOT_STATES_TOPIC, ROBOT_STATES_QOS),
-                                     (TaskEvent, TASK_EVENTS_TOPIC, EVENTS_QOS),
-                                     (MissionEvent, MISSION_EVENTS_TOPIC, EVENTS_QOS),
-                                     (MissionStatus, MISSION_STATUS_TOPIC, LATCHED_QOS)):
-            self.create_subscription(msg_type, topic, self.receiver(msg_type.__name__, topic),
-                                     qos)
-        self.diagnostics_pub = self.create_publisher(DiagnosticArray, DIAGNOSTICS_TOPIC,
-                                                     DIAGNOSTICS_QOS)
-        self.create_timer(refresh_period, self.refresh)
-        self.create_timer(diagnostics_period, self.publish_diagnostics)
+        self.auth = NodeAuth(self, MONITOR_NODE)
+        for topic in (PLAN, ROBOT_STATES, TASK_EVENTS, MISSION_EVENTS, MISSION_STATUS):
+            subscription(self, topic, self.receiver(topic.type.__name__, topic.name))
+        self.diagnostics_pub = publisher(self, DIAGNOSTICS)
+        self.create_timer(value['refresh_period'], self.refresh)
+        self.create_timer(value['diagnostics_period'], self.publish_diagnostics)
         if self.dashboard is not None:
-            self.create_timer(web_period, self.push_page)
+            self.create_timer(value['web_period'], self.push_page)
 
     def receiver(self, type_name: str, topic: str):
         def receive(msg) -> None:
@@ -149,43 +145,43 @@ class MonitorNode(Node):
     # --- the log ---------------------------------------------------------------------
 
     def refresh(self) -> None:
-        now = time.time()
+        wall = time.time()
         log = self.get_logger()
         for mission in self.missions_by_start():
-            for item in views.story(self.fleet, mission, now):
+            for item in views.story(self.fleet, mission, wall):
                 if (mission.mission_id, item['key']) not in self.told:
                     self.told.add((mission.mission_id, item['key']))
                     log.info(text.story_line(item))
         current = self.fleet.current()
-        shown, key = text.frame(views.header(current, now) if current is not None else None,
-                                views.robot_rows(self.fleet, current, now))
+        shown, key = text.frame(views.header(current, wall) if current is not None else None,
+                                views.robot_rows(self.fleet, current, wall))
         if key != self.frame_key:
             self.frame_key = key
             log.info('\n' + shown)
-        self.draw_ended(now)
+        self.draw_ended(wall)
 
     def missions_by_start(self) -> list[MissionHistory]:
         return sorted(self.fleet.missions.values(), key=lambda m: m.last_stamp)
 
-    def draw_ended(self, now: float) -> None:
+    def draw_ended(self, wall: float) -> None:
         """Summarise and draw each mission once it ended and its last events came in."""
         for mission in list(self.fleet.missions.values()):
             if not mission.ended or mission.mission_id in self.drawn:
                 continue
-            since = self.ended_since.setdefault(mission.mission_id, now)
-            if not mission.agrees_with_status() and now - since < self.event_grace:
+            since = self.ended_since.setdefault(mission.mission_id, wall)
+            if not mission.agrees_with_status() and wall - since < self.event_grace:
                 continue
             self.drawn.add(mission.mission_id)
-            self.report(mission, now)
+            self.report(mission, wall)
             if self.exit_on_complete:
                 self.finished = True
 
-    def report(self, mission: MissionHistory, now: float) -> None:
+    def report(self, mission: MissionHistory, wall: float) -> None:
         """Log the summary; write the Gantt chart and the history (JSON) to out_dir."""
         log = self.get_logger()
         path = self.out_dir / f'{safe_file_name(mission.mission_id)}.png'
         try:
-            write_mission(self.fleet, mission, now, path)
+            write_mission(self.fleet, mission, wall, path)
             where = f'Gantt chart: {path}'
         except OSError as error:
             where = f'could not write the Gantt chart {path}: {error.strerror or error}'
@@ -195,29 +191,29 @@ class MonitorNode(Node):
 
     def push_page(self) -> None:
         """Send the page what changed since the last push."""
-        now = time.time()
+        wall = time.time()
         version, at = self.pushed_version
-        if self.fleet.version == version and now - at < TIMELINE_PERIOD:
+        if self.fleet.version == version and wall - at < TIMELINE_PERIOD:
             return
-        self.pushed_version = (self.fleet.version, now)
+        self.pushed_version = (self.fleet.version, wall)
         current = self.fleet.current()
         parts = {'missions': views.missions(self.fleet)}
-        parts['robots'] = views.robot_rows(self.fleet, current, now)
+        parts['robots'] = views.robot_rows(self.fleet, current, wall)
         if current is None:
             parts['mission'] = {'mission_id': '', 'scenario': '', 'state': 'no mission yet',
                                 'planner': views.planner_state(self.fleet)}
         else:
-            header = views.header(current, now)
+            header = views.header(current, wall)
             header['planner'] = views.planner_state(self.fleet)
             parts['mission'] = header
-            parts['story'] = views.story(self.fleet, current, now)
+            parts['story'] = views.story(self.fleet, current, wall)
             # The timeline is the largest part: rebuilt when the mission's facts changed, else
             # only as often as its clock needs.
             mission_id, version, at = self.pushed_timeline
             if (mission_id, version) != (current.mission_id, current.version) \
-                    or now - at >= TIMELINE_PERIOD:
-                self.pushed_timeline = (current.mission_id, current.version, now)
-                parts['timeline'] = views.timeline(self.fleet, current, now)
+                    or wall - at >= TIMELINE_PERIOD:
+                self.pushed_timeline = (current.mission_id, current.version, wall)
+                parts['timeline'] = views.timeline(self.fleet, current, wall)
         self.dashboard.publish(parts)
 
     # --- diagnostics -----------------------------------------------------------------
@@ -226,8 +222,8 @@ class MonitorNode(Node):
         current = self.fleet.current()
         if current is None:
             return
-        now = time.time()
-        silent = self.fleet.silent(current, now)
+        wall = time.time()
+        silent = self.fleet.silent(current, wall)
         statuses = []
         for robot in current.robot_names():
             state = self.fleet.robots.get(robot)
@@ -238,7 +234,7 @@ class MonitorNode(Node):
                 late_by=self.lateness(current, state) if state is not None else 0.0,
                 late_threshold=self.late_threshold,
                 refusal=state.refusal if state is not None else '',
-                silent_for=now - silent[robot] if robot in silent else None,
+                silent_for=wall - silent[robot] if robot in silent else None,
                 values={'mission': current.mission_id,
                         'plan revision': state.revision if state is not None else 0,
                         'location': state.location if state is not None else ''}))
@@ -267,4 +263,4 @@ class MonitorNode(Node):
 
 
 def main(args=None):
-    sys.exit(run_node(MonitorNode, 'monitor', args, done=lambda node: node.finished))
+    sys.exit(run_node(MonitorNode, MONITOR_NODE, args, done=lambda node: node.finished))

@@ -18,38 +18,39 @@ from concurrent.futures import Future, ThreadPoolExecutor
 from datetime import UTC, datetime
 from pathlib import Path
 
-from diagnostic_msgs.msg import DiagnosticArray
 from rclpy.action import ActionServer, CancelResponse, GoalResponse
 from rclpy.node import Node
 from rclpy.serialization import deserialize_message, serialize_message
 from rclpy.task import Future as RosFuture
 from rclpy.time import Time
 
-from fjsp_common.auth import PLANNER, NodeAuth
+from fjsp_common.auth import NodeAuth
 from fjsp_common.contract import (
     ADD_JOBS_SERVICE,
     CANCEL_MISSION_SERVICE,
+    DIAGNOSTICS,
     EVENT_FROM_MSG,
-    EVENTS_QOS,
+    JOB_STATES,
     JOB_STATES_TOPIC,
-    LATCHED_QOS,
     MISSION_EVENT_TO_MSG,
+    MISSION_EVENTS,
     MISSION_EVENTS_TOPIC,
+    MISSION_STATUS,
     MISSION_STATUS_TOPIC,
     MODE_FROM_MSG,
+    PLAN,
     PLAN_TOPIC,
-    ROBOT_STATES_QOS,
+    ROBOT_STATES,
     ROBOT_STATES_TOPIC,
     RUN_MISSION_ACTION,
     STATE_TO_MSG,
+    TASK_EVENTS,
     TASK_EVENTS_TOPIC,
+    publisher,
+    subscription,
 )
-from fjsp_common.diagnostics import (
-    DIAGNOSTICS_QOS,
-    DIAGNOSTICS_TOPIC,
-    diagnostic_array,
-    planner_diagnostic,
-)
+from fjsp_common.diagnostics import diagnostic_array, planner_diagnostic
+from fjsp_common.fleet import DIAGNOSTICS_PERIOD, PLANNER_NODE
 from fjsp_common.running import ParameterError, declare, run_node, shorten
 from fjsp_common.vocabulary import MissionEventKind, MissionState
 from fjsp_msgs.action import RunMission
@@ -65,32 +66,27 @@ from fjsp_planner.execution.journal import (
     journal_path,
     journals,
 )
-from fjsp_planner.execution.mission.controller import (
-    EventReport,
+from fjsp_planner.execution.mission.controller import MissionController
+from fjsp_planner.execution.mission.effects import (
     JobDone,
-    MissionController,
     Note,
     PublishPlan,
     ResendPlan,
-    RobotReport,
-    Settings,
     Solve,
+    SolveKind,
 )
+from fjsp_planner.execution.mission.reports import EventReport, RobotReport
+from fjsp_planner.execution.mission.settings import PARAMETERS, SETTINGS_PARAMETERS, Settings
 from fjsp_planner.execution.replan import improve, repair
 from fjsp_planner.execution.tracking import Ignored
 from fjsp_planner.model.extension import extend
 from fjsp_planner.model.problem import ProblemError
 from fjsp_planner.model.scenario import load_scenario, scenario_from_text
 from fjsp_planner.nodes.conversions import cancel_msg, job_states, plan_msg
-from fjsp_planner.solving.solve import SOLVERS, solve
+from fjsp_planner.solving.solve import solve
 
 ANSWERS_KEPT = 256
 """Answers kept per service for requests that are resent."""
-
-RUNTIME_PARAMETERS = ('time_limit', 'replan_time_limit', 'workers', 'heartbeat_timeout',
-                      'delay_threshold', 'robot_wait_timeout', 'plan_uptake_timeout')
-"""Honoured when set at run time (read at each use); every other parameter is read-only."""
-
 
 SOLVER_NICENESS = 10
 
@@ -156,49 +152,13 @@ def describe(note: Note) -> str:
 
 
 class PlannerNode(Node):
-    def __init__(self):
-        super().__init__('planner')
-        scenario = declare(self, 'scenario', '',
-                           'scenario file of a mission to run at start-up; empty: wait for '
-                           'RunMission goals')
-        panels = declare(self, 'panels', 0, "panels of the scenario's job set; 0: the file's",
-                         low=0, high=50)
-        shift = declare(self, 'shift', -1.0,
-                        "distance added per panel apart; negative: the file's", low=-1.0,
-                        high=1e6)
-        self.solver = declare(self, 'solver', 'cpsat', 'solver of the first plan',
-                              constraints='one of: ' + ', '.join(SOLVERS))
-        if self.solver not in SOLVERS:
-            raise ParameterError(f"parameter 'solver' must be one of {', '.join(SOLVERS)}, "
-                                 f'got {shorten(self.solver, 80)!r}')
-        declare(self, 'time_limit', 10.0, 'seconds the first plan may take', low=0.01,
-                high=3600.0, read_only=False)
-        declare(self, 'replan_time_limit', 1.0, 'seconds a re-plan may take', low=0.01,
-                high=600.0, read_only=False)
-        declare(self, 'workers', 2, 'CP-SAT search workers', low=1, high=64, read_only=False)
-        declare(self, 'heartbeat_timeout', 1.0,
-                'seconds without a robot state before a robot is offline', low=0.05,
-                high=600.0, read_only=False)
-        declare(self, 'delay_threshold', 2.0,
-                'schedule units an operation may run late before a re-plan', low=0.0,
-                high=1e6, read_only=False)
-        declare(self, 'robot_wait_timeout', 15.0,
-                'seconds to wait for every robot to report before planning without it',
-                low=0.0, high=3600.0, read_only=False)
-        declare(self, 'plan_uptake_timeout', 10.0,
-                'seconds a reporting robot may stay on an older plan revision than the latest '
-                'before it is planned without', low=0.1, high=3600.0, read_only=False)
-        self.time_scale = declare(self, 'time_scale', 0.05,
-                                  'wall seconds per schedule unit', low=1e-4, high=1000.0)
-        self.start_delay = declare(self, 'start_delay', 0.5,
-                                   'seconds from the first plan to the mission start',
-                                   low=0.0, high=3600.0)
-        status_period = declare(self, 'status_period', 0.5,
-                                'seconds between periodic status publications', low=0.01,
-                                high=60.0)
-        journal_dir = declare(self, 'journal_dir', '',
-                              'directory of the mission journals that let a restarted planner '
-                              'resume its mission; empty: no journal')
+    def __init__(self, context=None):
+        super().__init__(PLANNER_NODE, context=context)
+        value = {name: declare(self, spec) for name, spec in PARAMETERS.items()}
+        scenario, panels, shift = value['scenario'], value['panels'], value['shift']
+        self.solver = value['solver']
+        self.time_scale, self.start_delay = value['time_scale'], value['start_delay']
+        status_period, journal_dir = value['status_period'], value['journal_dir']
         self.journal_dir = Path(journal_dir).expanduser() if journal_dir else None
         problem = None
         if scenario:
@@ -212,7 +172,7 @@ class PlannerNode(Node):
                                      + '\n'.join(problems)) from None
             origin = origin_of(text, panels, shift)
 
-        self.auth = NodeAuth(self, PLANNER)
+        self.auth = NodeAuth(self, PLANNER_NODE)
         self.controller = MissionController(self.settings())
         self.journal: Journal | None = None
         self.goal: Goal | None = None
@@ -240,20 +200,18 @@ class PlannerNode(Node):
         """Set under `waking` once the node is being destroyed: a solve ending then has no
         guard condition left to trigger."""
 
-        self.plan_pub = self.create_publisher(Plan, PLAN_TOPIC, LATCHED_QOS)
-        self.status_pub = self.create_publisher(MissionStatus, MISSION_STATUS_TOPIC, LATCHED_QOS)
-        self.jobs_pub = self.create_publisher(JobStates, JOB_STATES_TOPIC, LATCHED_QOS)
-        self.event_pub = self.create_publisher(TaskEvent, TASK_EVENTS_TOPIC, EVENTS_QOS)
-        self.story_pub = self.create_publisher(MissionEvent, MISSION_EVENTS_TOPIC, EVENTS_QOS)
-        self.create_subscription(RobotState, ROBOT_STATES_TOPIC, self.on_robot_state,
-                                 ROBOT_STATES_QOS)
-        self.create_subscription(TaskEvent, TASK_EVENTS_TOPIC, self.on_event, EVENTS_QOS)
-        self.create_subscription(Plan, PLAN_TOPIC, self.on_plan, LATCHED_QOS)
-        self.diagnostics_pub = self.create_publisher(DiagnosticArray, DIAGNOSTICS_TOPIC,
-                                                     DIAGNOSTICS_QOS)
+        self.plan_pub = publisher(self, PLAN)
+        self.status_pub = publisher(self, MISSION_STATUS)
+        self.jobs_pub = publisher(self, JOB_STATES)
+        self.event_pub = publisher(self, TASK_EVENTS)
+        self.story_pub = publisher(self, MISSION_EVENTS)
+        subscription(self, ROBOT_STATES, self.on_robot_state)
+        subscription(self, TASK_EVENTS, self.on_event)
+        subscription(self, PLAN, self.on_plan)
+        self.diagnostics_pub = publisher(self, DIAGNOSTICS)
         self.create_timer(0.1, self.tick)
         self.create_timer(status_period, self.publish_periodic)
-        self.create_timer(1.0, self.publish_diagnostics)
+        self.create_timer(DIAGNOSTICS_PERIOD, self.publish_diagnostics)
         ActionServer(self, RunMission, RUN_MISSION_ACTION, self.execute_goal,
                      goal_callback=lambda _: GoalResponse.ACCEPT,
                      cancel_callback=self.cancel_goal)
@@ -281,14 +239,8 @@ class PlannerNode(Node):
     # --- parameters and time -------------------------------------------------------------
 
     def settings(self) -> Settings:
-        value = {name: self.get_parameter(name).value for name in RUNTIME_PARAMETERS}
-        return Settings(time_limit=value['time_limit'],
-                        replan_time_limit=value['replan_time_limit'],
-                        heartbeat_timeout=value['heartbeat_timeout'],
-                        delay_threshold=value['delay_threshold'],
-                        robot_wait_timeout=value['robot_wait_timeout'],
-                        plan_uptake_timeout=value['plan_uptake_timeout'],
-                        start_delay=self.start_delay, time_scale=self.time_scale)
+        return Settings.from_parameters({name: self.get_parameter(name).value
+                                         for name in SETTINGS_PARAMETERS})
 
     def wall(self) -> float:
         return self.get_clock().now().nanoseconds * 1e-9
@@ -586,7 +538,7 @@ class PlannerNode(Node):
     def on_event(self, msg: TaskEvent) -> None:
         if msg.kind == TaskEvent.KIND_JOB_DONE and msg.event_id in self.job_done_ids:
             return  # its own
-        senders = {PLANNER} if msg.kind == TaskEvent.KIND_JOB_DONE else {msg.robot}
+        senders = {PLANNER_NODE} if msg.kind == TaskEvent.KIND_JOB_DONE else {msg.robot}
         if not self.auth.accept(msg, TASK_EVENTS_TOPIC, senders):
             return
         kind = EVENT_FROM_MSG.get(msg.kind)
@@ -605,7 +557,7 @@ class PlannerNode(Node):
     def on_plan(self, msg: Plan) -> None:
         if (msg.mission_id, msg.revision, msg.stamp) == self.last_published:
             return
-        if not self.auth.accept(msg, PLAN_TOPIC, {PLANNER}):
+        if not self.auth.accept(msg, PLAN_TOPIC, {PLANNER_NODE}):
             return
         current = self.controller.mission
         revision = current.tracker.revision if current is not None else 0
@@ -627,15 +579,15 @@ class PlannerNode(Node):
 
     def solve(self, request: Solve) -> None:
         workers = self.get_parameter('workers').value
-        if request.kind == 'plan':
+        if request.kind == SolveKind.PLAN:
             self.get_logger().info(f'solving with {self.solver}, time limit '
                                    f'{request.time_limit:g} s, {workers} workers')
             future = self.pool.submit(solve, request.problem, solver=self.solver,
                                       time_limit=request.time_limit, workers=workers)
-        elif request.kind == 'repair':
+        elif request.kind == SolveKind.REPAIR:
             self.replan_began = time.monotonic()
-            now = self.controller.now_units(self.wall())
-            self.get_logger().warning(f're-planning at t={now:.2f}: '
+            now_units = self.controller.now_units(self.wall())
+            self.get_logger().warning(f're-planning at t={now_units:.2f}: '
                                       + shorten('; '.join(request.reasons), 2000))
             future = self.pool.submit(repair, request.problem, request.previous,
                                       request.state, time_limit=request.time_limit)
@@ -727,12 +679,12 @@ class PlannerNode(Node):
         if effect.revision > 1 and self.replan_began is not None:
             self.replan_latency, self.replan_began = time.monotonic() - self.replan_began, None
         gap = f', gap {result.gap:.1%}' if result.gap is not None else ''
-        now = self.controller.now_units(self.wall())
+        now_units = self.controller.now_units(self.wall())
         log.info(f'published plan revision {effect.revision}: makespan '
                  f'{float(result.makespan):g} ({result.status}{gap}, '
                  f'{result.solve_seconds:.2f} s)'
                  + (f'; mission starts in {self.start_delay:g} s at {self.time_scale:g} s '
-                    'per unit' if effect.revision == 1 else f' at t={now:.2f}'))
+                    'per unit' if effect.revision == 1 else f' at t={now_units:.2f}'))
         for robot_plan in msg.robots:
             log.info(f'  {robot_plan.robot}: '
                      + (' -> '.join(t.job for t in robot_plan.tasks) or 'no task'))
@@ -744,7 +696,7 @@ class PlannerNode(Node):
         # A subscription that has not matched the writer in seconds may never match it; a new
         # writer is announced to every subscription afresh.
         self.destroy_publisher(self.plan_pub)
-        self.plan_pub = self.create_publisher(Plan, PLAN_TOPIC, LATCHED_QOS)
+        self.plan_pub = publisher(self, PLAN)
         self.plan_pub.publish(self.auth.sign(msg, PLAN_TOPIC))
         self.get_logger().warning(f'published plan revision {msg.revision} again, on a new '
                                   'writer')
@@ -874,4 +826,4 @@ def write_plan_file(path: Path, msg: Plan) -> None:
 
 
 def main(args=None):
-    sys.exit(run_node(PlannerNode, 'planner', args))
+    sys.exit(run_node(PlannerNode, PLANNER_NODE, args))

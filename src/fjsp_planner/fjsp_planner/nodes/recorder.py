@@ -14,24 +14,13 @@ from datetime import UTC, datetime
 from pathlib import Path
 
 from ament_index_python.packages import PackageNotFoundError, get_package_share_directory
-from diagnostic_msgs.msg import DiagnosticArray
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, ReliabilityPolicy
 
-from fjsp_common.contract import (
-    EVENTS_QOS,
-    JOB_STATES_TOPIC,
-    LATCHED_QOS,
-    MISSION_EVENTS_TOPIC,
-    MISSION_STATUS_TOPIC,
-    PLAN_TOPIC,
-    ROBOT_STATES_QOS,
-    ROBOT_STATES_TOPIC,
-    TASK_EVENTS_TOPIC,
-)
-from fjsp_common.diagnostics import DIAGNOSTICS_QOS, DIAGNOSTICS_TOPIC
+from fjsp_common.contract import TOPICS, subscription
+from fjsp_common.fleet import RECORDER_NODE
+from fjsp_common.parameters import ParameterSpec, table
 from fjsp_common.running import ParameterError, declare, run_node
-from fjsp_msgs.msg import JobStates, MissionEvent, MissionStatus, Plan, RobotState, TaskEvent
 from fjsp_planner.observe.recording import (
     COMPRESSIONS,
     Offer,
@@ -41,14 +30,16 @@ from fjsp_planner.observe.recording import (
 )
 from fjsp_planner.workspace import default_out_dir
 
-TOPICS = ((PLAN_TOPIC, Plan, LATCHED_QOS),
-          (ROBOT_STATES_TOPIC, RobotState, ROBOT_STATES_QOS),
-          (TASK_EVENTS_TOPIC, TaskEvent, EVENTS_QOS),
-          (MISSION_EVENTS_TOPIC, MissionEvent, EVENTS_QOS),
-          (MISSION_STATUS_TOPIC, MissionStatus, LATCHED_QOS),
-          (JOB_STATES_TOPIC, JobStates, LATCHED_QOS),
-          (DIAGNOSTICS_TOPIC, DiagnosticArray, DIAGNOSTICS_QOS))
-"""Every topic of a mission: (name, type, the QoS its publishers offer)."""
+PARAMETERS = table(
+    ParameterSpec('out_dir', '', "directory of the recording; empty: the workspace's out/ "
+                  '(else ~/.ros/fjsp/out)'),
+    ParameterSpec('file_name', '', 'name of the .mcap file; empty: fjsp_<UTC start time>.mcap'),
+    ParameterSpec('compression', 'zstd', 'chunk compression of the MCAP file',
+                  choices=tuple(COMPRESSIONS)),
+    ParameterSpec('flush_period', 2.0, 'seconds between writes to disk (what a crash may lose)',
+                  low=0.1, high=3600.0),
+)
+"""The recorder's parameters, in the order it declares them."""
 
 
 def type_name(msg_type) -> str:
@@ -68,21 +59,10 @@ def installed_msg(package: str, name: str) -> str:
 
 class RecorderNode(Node):
     def __init__(self):
-        super().__init__('recorder')
-        out_dir = declare(self, 'out_dir', '',
-                          "directory of the recording; empty: the workspace's out/ (else "
-                          '~/.ros/fjsp/out)')
-        file_name = declare(self, 'file_name', '',
-                            'name of the .mcap file; empty: fjsp_<UTC start time>.mcap')
-        compression = declare(self, 'compression', 'zstd',
-                              'chunk compression of the MCAP file',
-                              constraints='one of: ' + ', '.join(COMPRESSIONS))
-        flush_period = declare(self, 'flush_period', 2.0,
-                               'seconds between writes to disk (what a crash may lose)',
-                               low=0.1, high=3600.0)
-        if compression not in COMPRESSIONS:
-            raise ParameterError(f"parameter 'compression' must be one of "
-                                 f"{', '.join(COMPRESSIONS)}, got {compression!r}")
+        super().__init__(RECORDER_NODE)
+        value = {name: declare(self, spec) for name, spec in PARAMETERS.items()}
+        out_dir, file_name = value['out_dir'], value['file_name']
+        compression = value['compression']
         directory = Path(out_dir).expanduser() if out_dir else default_out_dir()
         name = file_name or f"fjsp_{datetime.now(UTC).strftime('%Y%m%dT%H%M%S')}.mcap"
         if Path(name).name != name:
@@ -96,19 +76,20 @@ class RecorderNode(Node):
                                  f'{error.strerror or error}') from None
         self.failed = False
         try:
-            for topic, msg_type, qos in TOPICS:
+            for topic in TOPICS:
+                # The QoS its readers use: a replay's one writer stands for all the fleet's.
+                qos = topic.qos
                 channel = self.writer.add_topic(
-                    self.resolve_topic_name(topic), type_name(msg_type),
-                    message_definition(type_name(msg_type), installed_msg),
+                    self.resolve_topic_name(topic.name), type_name(topic.type),
+                    message_definition(type_name(topic.type), installed_msg),
                     Offer(reliable=qos.reliability == ReliabilityPolicy.RELIABLE,
                           transient_local=qos.durability == DurabilityPolicy.TRANSIENT_LOCAL,
                           depth=qos.depth))
-                self.create_subscription(msg_type, topic, self.recording(channel), qos,
-                                         raw=True)
+                subscription(self, topic, self.recording(channel), raw=True)
         except RecordingError as error:
             self.writer.close()
             raise ParameterError(f'cannot record: {error}') from None
-        self.create_timer(flush_period, self.flush)
+        self.create_timer(value['flush_period'], self.flush)
         self.get_logger().info(f'recording {len(TOPICS)} topics to {self.writer.path}')
 
     def recording(self, channel: int):
@@ -147,4 +128,4 @@ class RecorderNode(Node):
 
 
 def main(args=None):
-    sys.exit(run_node(RecorderNode, 'recorder', args))
+    sys.exit(run_node(RecorderNode, RECORDER_NODE, args))

@@ -13,6 +13,8 @@ import re
 from collections.abc import Mapping
 from dataclasses import dataclass
 
+from fjsp_common.clock import ScheduleClock, seconds
+from fjsp_common.revisions import attempt_revision
 from fjsp_common.vocabulary import EventKind, MissionEventKind, MissionState, RobotMode
 
 VOCABULARIES = {
@@ -51,7 +53,7 @@ class PlannedTask:
     def attempt_since(self, revision: int) -> int:
         """The revision whose attempt at the job this task, of plan `revision`, goes on with
         (0: unknown)."""
-        return revision if not self.continued else min(self.restarted_in, revision)
+        return attempt_revision(revision, self.continued, self.restarted_in)
 
 
 @dataclass(frozen=True)
@@ -71,6 +73,13 @@ class PlanFact:
     robots: tuple[tuple[str, str], ...]
     """(robot, robot type) of every robot of the scenario, in the plan's order."""
     tasks: tuple[PlannedTask, ...]
+
+    @property
+    def clock(self) -> ScheduleClock | None:
+        """The mission's schedule time as this plan gives it (None for a time scale that is
+        not positive)."""
+        return ScheduleClock(self.mission_start, self.time_scale) if self.time_scale > 0 \
+            else None
 
 
 @dataclass(frozen=True)
@@ -143,11 +152,6 @@ _CONSTANT = re.compile(r'^\s*(?:u?int(?:8|16|32|64)|byte|char)\s+([A-Z][A-Z0-9_]
                        re.MULTILINE)
 _SECTION = re.compile(r'^={3,}\s*$', re.MULTILINE)
 _SECTION_NAME = re.compile(r'^MSG:\s*(\S+)\s*$', re.MULTILINE)
-
-
-def seconds(stamp) -> float:
-    """A `builtin_interfaces/Time` as seconds since the epoch."""
-    return stamp.sec + stamp.nanosec * 1e-9
 
 
 def short_type(type_name: str) -> str:

@@ -32,6 +32,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from enum import StrEnum
 
+from fjsp_common.fleet import HEARTBEAT_TIMEOUT
 from fjsp_common.vocabulary import EventKind, MissionEventKind, MissionState, RobotMode
 from fjsp_planner.observe.facts import (
     Fact,
@@ -227,10 +228,8 @@ class MissionHistory:
 
     def units(self, stamp: float) -> float | None:
         """Schedule time of a wall stamp (None before any plan says when the mission began)."""
-        plan = self.first_plan
-        if plan is None or not plan.time_scale > 0:
-            return None
-        return (stamp - plan.mission_start) / plan.time_scale
+        clock = self.first_plan.clock if self.plans else None
+        return None if clock is None else clock.units(stamp)
 
     @property
     def scenario_id(self) -> str:
@@ -508,7 +507,7 @@ class MissionHistory:
 class FleetHistory:
     """Every mission seen on one fleet (by mission id), and each robot's latest state."""
 
-    def __init__(self, heartbeat_timeout: float = 1.0):
+    def __init__(self, heartbeat_timeout: float = HEARTBEAT_TIMEOUT):
         self.heartbeat_timeout = heartbeat_timeout
         self.missions: dict[str, MissionHistory] = {}
         self.robots: dict[str, RobotStateFact] = {}
@@ -556,12 +555,12 @@ class FleetHistory:
         # Progress and heartbeats change the live view even when the trail does not.
         return True
 
-    def silent(self, mission: MissionHistory | None, now: float) -> dict[str, float]:
-        """Robots silent at wall time `now` (robot -> its last stamp): those following
+    def silent(self, mission: MissionHistory | None, wall: float) -> dict[str, float]:
+        """Robots silent at wall time `wall` (robot -> its last stamp): those following
         `mission` or no mission yet; with `mission` None, every robot."""
         return {robot: state.stamp for robot, state in self.robots.items()
                 if (mission is None or state.mission_id in ('', mission.mission_id))
-                and now - state.stamp > self.heartbeat_timeout}
+                and wall - state.stamp > self.heartbeat_timeout}
 
     def current(self) -> MissionHistory | None:
         """The mission the planner reports on most recently (else the latest planned)."""

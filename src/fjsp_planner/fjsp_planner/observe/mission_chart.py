@@ -46,7 +46,7 @@ def draw_mission(timeline: dict, header: dict, path: Path) -> Path:
     robots = timeline['robots']
     rows = {robot: len(robots) - 1 - index for index, robot in enumerate(robots)}
     end = max(timeline['end'] or 1.0, 1.0)
-    now = timeline['now']
+    now_units = timeline['now']
     colour = job_colours([w['job'] for w in timeline['work']]
                          + [t['job'] for p in timeline['plans'] for t in p['tasks']])
     notes = [f"r{r['number']} at t={r['time']:.1f}: "
@@ -68,7 +68,7 @@ def draw_mission(timeline: dict, header: dict, path: Path) -> Path:
         if span['robot'] in rows:
             y = rows[span['robot']]
             colour_, alpha = HEALTH_COLOUR.get(span['kind'], ('grey', 0.2))
-            start, stop = clip(span['start']), clip(now if span['open'] else span['end'])
+            start, stop = clip(span['start']), clip(now_units if span['open'] else span['end'])
             ax.barh(y, stop - start, left=start, height=0.96, color=colour_, alpha=alpha, lw=0)
             ax.plot([start], [y + 0.44], marker='X', color='red', markersize=9)
             if not span['open']:
@@ -92,7 +92,7 @@ def draw_mission(timeline: dict, header: dict, path: Path) -> Path:
         if w['robot'] not in rows:
             continue
         y = rows[w['robot']] + WORK
-        stop = clip(now if w['open'] else w['end'])
+        stop = clip(now_units if w['open'] else w['end'])
         style = OUTCOME_STYLE.get(w['outcome'], OUTCOME_STYLE['done'])
         ax.barh(y, max(stop - w['start'], 0.05), left=w['start'], height=0.3,
                 color=colour[w['job']], **style)
@@ -102,7 +102,7 @@ def draw_mission(timeline: dict, header: dict, path: Path) -> Path:
     for a in timeline['activities']:
         style = ACTIVITY_STYLE.get(a['mode'])
         if style and a['robot'] in rows:
-            start, stop = clip(a['start']), clip(now if a['open'] else a['end'])
+            start, stop = clip(a['start']), clip(now_units if a['open'] else a['end'])
             if stop > start:
                 y = rows[a['robot']] + ACTIVITY
                 ax.plot([start, stop], [y, y], solid_capstyle='butt', **style)
@@ -113,9 +113,9 @@ def draw_mission(timeline: dict, header: dict, path: Path) -> Path:
         ax.axvline(x, color='purple', linestyle='--', lw=1)
         ax.text(x, len(robots) - 0.45, f" r{r['number']}", color='purple', fontsize=8,
                 va='bottom')
-    if now is not None and not header['ended']:
-        ax.axvline(now, color='black', lw=1.2)
-        ax.text(now, -0.62, ' now', fontsize=8)
+    if now_units is not None and not header['ended']:
+        ax.axvline(now_units, color='black', lw=1.2)
+        ax.text(now_units, -0.62, ' now', fontsize=8)
     ax.set_yticks(range(len(robots)), list(reversed(robots)))
     ax.set_ylim(-0.65, len(robots) - 0.3)
     ax.set_xlim(0, end * 1.02)
@@ -134,13 +134,13 @@ def draw_mission(timeline: dict, header: dict, path: Path) -> Path:
     return path
 
 
-def write_mission(fleet: FleetHistory, mission: MissionHistory, now: float, png: Path) -> None:
+def write_mission(fleet: FleetHistory, mission: MissionHistory, wall: float, png: Path) -> None:
     """The mission's chart to `png`, and what it was drawn from beside it (`.json`: the
     mission line, the timeline and the story, for other tools)."""
-    header, timeline = views.header(mission, now), views.timeline(fleet, mission, now)
+    header, timeline = views.header(mission, wall), views.timeline(fleet, mission, wall)
     draw_mission(timeline, header, png)
     Path(png).with_suffix('.json').write_text(json.dumps(
-        {'mission': header, 'timeline': timeline, 'story': views.story(fleet, mission, now)},
+        {'mission': header, 'timeline': timeline, 'story': views.story(fleet, mission, wall)},
         indent=1, allow_nan=False))
 
 

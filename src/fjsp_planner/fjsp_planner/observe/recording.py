@@ -27,6 +27,7 @@ from mcap.well_known import MessageEncoding, SchemaEncoding
 from mcap.writer import CompressionType, Writer
 from mcap_ros2.decoder import DecoderFactory
 
+from fjsp_common.fleet import HEARTBEAT_TIMEOUT
 from fjsp_planner.observe.facts import Decoder, UnreadableMessageError
 from fjsp_planner.observe.history import FleetHistory
 
@@ -255,7 +256,8 @@ def _until_damaged(messages, reading: Reading):
         yield item
 
 
-def replay(path: Path, heartbeat_timeout: float = 1.0) -> tuple[FleetHistory, Reading]:
+def replay(path: Path, heartbeat_timeout: float = HEARTBEAT_TIMEOUT
+           ) -> tuple[FleetHistory, Reading]:
     """The fleet's history as the recording tells it, and what reading it found."""
     reading = Reading()
     fleet = FleetHistory(heartbeat_timeout)

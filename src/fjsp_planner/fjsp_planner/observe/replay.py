@@ -11,6 +11,7 @@ import argparse
 import sys
 from pathlib import Path
 
+from fjsp_common.fleet import HEARTBEAT_TIMEOUT
 from fjsp_planner.observe import text, views
 from fjsp_planner.observe.mission_chart import write_mission
 from fjsp_planner.observe.recording import RecordingError, replay
@@ -36,9 +37,9 @@ def parse(argv):
                         help="directory of the charts (default: the recording's)")
     parser.add_argument('--mission', default='',
                         help='only this mission id (default: every mission recorded)')
-    parser.add_argument('--heartbeat-timeout', type=positive, default=1.0,
+    parser.add_argument('--heartbeat-timeout', type=positive, default=HEARTBEAT_TIMEOUT,
                         help='seconds without a robot state that count as offline '
-                        '(default 1.0, as the nodes)')
+                        f'(default {HEARTBEAT_TIMEOUT}, as the nodes)')
     parser.add_argument('--no-chart', action='store_true', help='print only, draw nothing')
     return parser.parse_args(argv)
 
@@ -66,16 +67,16 @@ def main(argv=None) -> int:
         print(f'replay: {args.recording} holds no {which}', file=sys.stderr)
         return 1
     out = args.out if args.out is not None else args.recording.resolve().parent
-    now = reading.last_time
+    wall = reading.last_time
     for mission in sorted(missions, key=lambda m: m.last_stamp):
         print()
         print(text.summary(mission))
-        for item in views.story(fleet, mission, now):
+        for item in views.story(fleet, mission, wall):
             print('  ' + text.story_line(item))
         if not args.no_chart:
             png = out / f'{safe_file_name(mission.mission_id)}.replay.png'
             try:
-                write_mission(fleet, mission, now, png)
+                write_mission(fleet, mission, wall, png)
             except OSError as error:
                 print(f'replay: cannot write {png}: {error.strerror or error}',
                       file=sys.stderr)

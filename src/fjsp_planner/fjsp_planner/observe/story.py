@@ -11,6 +11,7 @@ import math
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 
+from fjsp_common.clock import ScheduleClock
 from fjsp_common.vocabulary import MissionEventKind, MissionState
 from fjsp_planner.observe.history import Counts, MissionHistory, Outcome
 
@@ -157,4 +158,4 @@ def _silent(mission: MissionHistory, silent: Mapping[str, float]) -> list[StoryI
 def _stamp_at(mission: MissionHistory, time: float) -> float:
     """The wall time of schedule time `time` (NaN before any plan)."""
     plan = mission.first_plan
-    return plan.mission_start + time * plan.time_scale if plan else math.nan
+    return ScheduleClock(plan.mission_start, plan.time_scale).wall(time) if plan else math.nan

@@ -1,12 +1,14 @@
 """What a person is shown of a mission, as plain data: the same for the terminal, the PNG chart
 and the web page, so the three never tell different stories.
 
-Every function takes the fleet's history, one mission and `now` (wall seconds since the epoch;
-for a recording: its last message) and returns JSON-ready dicts. Times are schedule units.
+Every function takes the fleet's history, one mission and `wall`, the moment shown (wall
+seconds since the epoch; for a recording: its last message), and returns JSON-ready dicts.
+Times in them are schedule units.
 """
 
 import math
 
+from fjsp_common.revisions import void
 from fjsp_common.vocabulary import EventKind, RobotMode
 from fjsp_planner.observe.history import FleetHistory, MissionHistory, Outcome
 from fjsp_planner.observe.story import story as told
@@ -20,14 +22,14 @@ def _number(value: float | None) -> float | None:
     return None if value is None or not math.isfinite(value) else round(value, 6)
 
 
-def now_units(mission: MissionHistory, now: float) -> float | None:
-    """Schedule time at wall time `now`; the mission's last known moment once it ended."""
+def now_units(mission: MissionHistory, wall: float) -> float | None:
+    """Schedule time at wall time `wall`; the mission's last known moment once it ended."""
     if mission.ended_at is not None:
         return max(mission.ended_at, mission.executed_makespan() or 0.0)
-    return mission.units(now)
+    return mission.units(wall)
 
 
-def header(mission: MissionHistory, now: float) -> dict:
+def header(mission: MissionHistory, wall: float) -> dict:
     """The mission line: state, revision, progress, makespans and the reasons in force."""
     s = mission.status
     counts = mission.counts()
@@ -49,7 +51,7 @@ def header(mission: MissionHistory, now: float) -> dict:
         'first_makespan': _number(mission.first_plan.makespan if last else None),
         'projected_makespan': _number(s.projected_makespan if s else None),
         'executed_makespan': _number(mission.executed_makespan()),
-        'time': _number(now_units(mission, now)),
+        'time': _number(now_units(mission, wall)),
         'replan_reasons': list(s.replan_reasons if s and s.replan_reasons
                                else last.reasons if last else ()),
         'warnings': list(s.warnings) if s else [],
@@ -58,12 +60,12 @@ def header(mission: MissionHistory, now: float) -> dict:
     }
 
 
-def robot_rows(fleet: FleetHistory, mission: MissionHistory | None, now: float) -> list[dict]:
+def robot_rows(fleet: FleetHistory, mission: MissionHistory | None, wall: float) -> list[dict]:
     """One row per robot: what it does, where, and what it waits for. The robots of
     `mission` (with their last state in it once it ended), then any robot following no
     mission (e.g. refusing its plan); with no mission, every robot that reported."""
     ended = mission is not None and mission.ended
-    silent = fleet.silent(mission, now) if not ended else {}
+    silent = fleet.silent(mission, wall) if not ended else {}
     names = mission.robot_names() if mission is not None else []
     names += sorted(r for r, s in fleet.robots.items() if r not in names
                     and (mission is None or not s.mission_id))
@@ -133,13 +135,14 @@ def _arrived(mission: MissionHistory, job: str, revision: int) -> set[str]:
     restarted = max((t.attempt_since(r) for r, p in mission.plans.items() if r <= revision
                      for t in p.tasks if t.job == job), default=0)
     return {e.robot for e in mission.task_events.values()
-            if e.job == job and e.kind == EventKind.ARRIVED and e.revision >= restarted}
+            if e.job == job and e.kind == EventKind.ARRIVED
+            and not void(e.revision, restarted)}
 
 
-def timeline(fleet: FleetHistory, mission: MissionHistory, now: float) -> dict:
+def timeline(fleet: FleetHistory, mission: MissionHistory, wall: float) -> dict:
     """The whole mission per robot: plans of the first and latest revisions, the work done
     in every attempt, activities, health spans and revision boundaries."""
-    t_now = now_units(mission, now)
+    t_now = now_units(mission, wall)
     revisions = mission.revisions()
     shown = sorted({revisions[0].number, revisions[-1].number}) if revisions else []
     plans = []
@@ -160,7 +163,7 @@ def timeline(fleet: FleetHistory, mission: MissionHistory, now: float) -> dict:
                          'open': attempt.finish is None, 'outcome': str(attempt.outcome),
                          'outcome_time': _number(attempt.outcome_time),
                          'reason': attempt.reason})
-    silent = fleet.silent(mission, now) if not mission.ended else {}
+    silent = fleet.silent(mission, wall) if not mission.ended else {}
     health = [{'robot': s.robot, 'kind': s.kind, 'start': _number(s.start),
                'end': _number(s.end), 'open': s.end is None} for s in mission.spans(silent)]
     activities = [{'robot': a.robot, 'mode': str(a.mode), 'job': a.job,
@@ -183,8 +186,8 @@ def timeline(fleet: FleetHistory, mission: MissionHistory, now: float) -> dict:
     }
 
 
-def story(fleet: FleetHistory, mission: MissionHistory, now: float) -> list[dict]:
-    silent = fleet.silent(mission, now) if not mission.ended else {}
+def story(fleet: FleetHistory, mission: MissionHistory, wall: float) -> list[dict]:
+    silent = fleet.silent(mission, wall) if not mission.ended else {}
     return [{'key': i.key, 'time': _number(i.time), 'kind': str(i.kind), 'text': i.text,
              'robot': i.robot, 'job': i.job, 'stamp': _number(i.stamp)}
             for i in told(mission, silent)]

@@ -1,45 +1,52 @@
 """The mission as the planner runs it, without ROS: what to plan, when to re-plan, when a
 mission is over.
 
-The planner node feeds a `MissionController` what it hears (robot states, task events), what
-it is asked (start or cancel a mission) and the passing of time (`tick`), and carries out the
-`Effect`s each call returns: run a solve off the executor, publish a plan, declare a job done,
-tell the story of the mission (`Note`). All times in are wall seconds of one clock (the ROS
-clock); schedule time is derived from the mission start and the time scale.
+The planner node feeds a `MissionController` what it hears (robot states, task events:
+`reports`), what it is asked (start or cancel a mission, add jobs) and the passing of time
+(`tick`), and carries out the `effects` each call returns: run a solve off the executor,
+publish a plan, declare a job done, tell the story of the mission (`Note`). All times in are
+wall seconds of one clock (the ROS clock); schedule time is derived from the mission start and
+the time scale.
 
-A robot takes part in planning only while it is *available*: it has reported, it is neither
-failed nor offline, and it follows the plans it is given (an agent that refuses a plan, e.g.
-for a robot type it cannot play, is left out and named in the warnings; so is one that keeps
-reporting an older revision than the latest, which it may never have received, until it
-reports the latest). The plan records, for
-each robot it counted on, the agent incarnation and failure count it saw; a robot that fails
-and recovers between two ticks, or whose agent restarts, lost its tasks even though it looks
-healthy, and is re-planned in. A robot whose heartbeat is lost is offline until it has been
-heard again for a full heartbeat timeout, so that one late heartbeat does not re-plan twice.
+Which robots it plans for is `liveness`'s judgement: a robot takes part while it is available.
+The plan records, for each robot it counted on, the agent incarnation and failure count it
+saw; a robot that fails and recovers between two ticks, or whose agent restarts, lost its
+tasks even though it looks healthy, and is re-planned in. Which jobs a new revision lets go on
+is `continuation`'s; a mission rebuilt after a planner restart comes from `resume`.
 """
 
 import math
 from collections import Counter
-from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from fractions import Fraction
 
+from fjsp_common.clock import ScheduleClock
 from fjsp_common.vocabulary import EventKind, MissionEventKind, MissionState, RobotMode
-from fjsp_planner.execution.journal import DoneRecord, PlanRecord, Record
-from fjsp_planner.execution.replan import ExecutionState, Replan, RobotState, residual_problem
+from fjsp_planner.execution.journal import Record
+from fjsp_planner.execution.mission import continuation
+from fjsp_planner.execution.mission.effects import (
+    Effect,
+    JobDone,
+    Note,
+    PublishPlan,
+    Solve,
+    SolveKind,
+    StatusView,
+)
+from fjsp_planner.execution.mission.liveness import Liveness
+from fjsp_planner.execution.mission.reports import EventReport, RobotReport
+from fjsp_planner.execution.mission.resume import restarted_while_down, restore, started_where
+from fjsp_planner.execution.mission.settings import Settings
+from fjsp_planner.execution.mission.states import INITIAL, check_transition
+from fjsp_planner.execution.replan import ExecutionState, Replan, RobotSituation, residual_problem
 from fjsp_planner.execution.tracking import Ignored, MissionTracker
 from fjsp_planner.model.problem import Problem
-from fjsp_planner.model.schedule import JobAssignment, Result, Schedule, Status
+from fjsp_planner.model.schedule import Result, Schedule, Status
 from fjsp_planner.model.validate import validate
 
 REPAIR_LIMIT = 0.5
 """Seconds the repair of a plan may take: a valid plan of what remains without search (a few
 hundred ms on 5 panels), published at once; the search for a better one follows."""
-
-EVENTS_REMEMBERED = 10000
-"""Ids of the latest task events remembered per robot, to tell when the event history a
-robot reports having published has arrived: twice what an agent's writer keeps for late
-joiners."""
 
 LONGEST_SEARCH = 16
 """The longest search for a better plan, in `replan_time_limit`s: searches that find nothing
@@ -49,218 +56,16 @@ IMPROVE_REACH = 0.5
 """Seconds beyond a search's time limit until its plan reaches the robots (the solver's
 overrun, publishing, the agents taking it): what they do by then is kept in it."""
 
-DUE_GRACE = 1.0
-"""Seconds after a job's start fell due (its robots arrived, its predecessors complete, by
-the reports the planner has) during which its robots' start reports are expected on their
-way: a new plan must let it go on as if it had been reported started. Longer, a report
-must be missing, and the plan is not held back for it."""
-
 RETRY_FAILED_REPLAN = 1.0
 """Seconds after which a re-plan that failed is tried again, if no new report came first."""
-
-PLAN_RESEND_AFTER = 2.0
-"""Seconds a robot that reports may stay on an older plan revision than the latest before
-the plan is published again, on a new writer: a sample lost on a matched subscription is
-resent by the reliable writer long before, so the robot's subscription is likely not matched
-to the writer at all."""
-
-STARVED = 0.25
-"""Seconds between two ticks beyond which the node could not take messages for a while: the
-heartbeats it has not processed yet come first, before any robot is judged silent."""
-
-
-@dataclass(frozen=True)
-class Settings:
-    """How the planner runs missions; the node refreshes them when its parameters change.
-
-    A mission keeps the time limits, start delay, time scale and blocked timeout it started
-    with (a goal may set them); the heartbeat, delay, robot wait and plan uptake thresholds
-    are always the controller's current ones, so a change applies to the running mission."""
-
-    time_limit: float = 10.0
-    replan_time_limit: float = 1.0
-    heartbeat_timeout: float = 1.0
-    delay_threshold: float = 2.0
-    robot_wait_timeout: float = 15.0
-    start_delay: float = 0.5
-    time_scale: float = 0.05
-    blocked_timeout: float = 0.0
-    """Seconds a mission may stay blocked before it fails; 0: it waits for the fleet."""
-    plan_uptake_timeout: float = 10.0
-    """Seconds a robot that reports may stay on an older plan revision than the latest before
-    it is planned without, until it reports the latest."""
-
-
-@dataclass(frozen=True)
-class RobotReport:
-    """One RobotState as the controller needs it."""
-
-    robot: str
-    mode: RobotMode
-    incarnation: int = 0
-    mission_id: str = ''
-    revision: int = 0
-    refusal: str = ''
-    failures: int = 0
-    robot_type: str = ''
-    location: str = ''
-    destination: str = ''
-    busy_until: float = math.nan
-    current_job: str = ''
-    last_event: str = ''
-    """The id of the latest task event the agent published ('' if none)."""
-
-
-@dataclass(frozen=True)
-class EventReport:
-    """One TaskEvent of an agent."""
-
-    event_id: str
-    mission_id: str
-    kind: EventKind
-    robot: str
-    job: str
-    revision: int
-    time: float
-
-
-# --- effects: what the node must do ----------------------------------------------------
-
-@dataclass(frozen=True)
-class Solve:
-    """Run a solve off the executor and hand its outcome to `MissionController.solved`.
-
-    kind 'plan': `solve(problem)`; kind 'repair': `repair(problem, previous, state)`, a valid
-    plan of what remains at once, without search; kind 'improve': `improve(published)`, a
-    search from the plan just published."""
-
-    token: int
-    kind: str
-    problem: Problem
-    time_limit: float
-    previous: Schedule | None = None
-    state: ExecutionState | None = None
-    reasons: tuple[str, ...] = ()
-    """Why a re-plan is needed."""
-    published: Replan | None = None
-    """For 'improve': the repaired plan to search from."""
-    frozen_until: float | None = None
-    """For 'improve': the schedule time by which its plan reaches the robots; what the
-    published plan has them do until then is kept (`replan.frozen`)."""
-    started: frozenset[str] = frozenset()
-    """For 'improve': the jobs the robots have started or done; they are kept too."""
-
-
-@dataclass(frozen=True)
-class PublishPlan:
-    revision: int
-    posed: Problem
-    """What was solved: the mission's problem, or what remained of it."""
-    result: Result | None
-    """None for the revision that cancels a mission."""
-    continued: frozenset[str]
-    reasons: tuple[str, ...]
-    mission_start: float
-    """Wall seconds of schedule time 0."""
-    cancelled: bool = False
-    restarted_in: Mapping[str, int] = field(default_factory=dict)
-    """Per job of the plan, the revision that last started it afresh (this one for a job
-    not continued): a robot that missed that revision still knows which reports are void."""
-    incarnations: Mapping[str, int] = field(default_factory=dict)
-    """The agent incarnation each robot's tasks are planned for: the one it reported."""
-    starts: Mapping[str, str | None] = field(default_factory=dict)
-    """Where each robot started the mission (None: anywhere), which need not be where the
-    scenario starts it: journaled, so a resumed mission is judged from the same places."""
-
-
-@dataclass(frozen=True)
-class JobDone:
-    job: str
-    time: float
-    revision: int
-    assignment: JobAssignment
-    """How it was done: its plan, robots and actual times."""
-
-
-@dataclass(frozen=True)
-class Note:
-    """Something the mission's story must tell (a MissionEvent)."""
-
-    kind: MissionEventKind
-    reasons: tuple[str, ...] = ()
-    robot: str = ''
-    job: str = ''
-    revision: int | None = None
-    """The plan revision it is about, when not the one in force when it is told (a voided
-    job: the revision its completion was reported under)."""
-
-
-@dataclass(frozen=True)
-class ResendPlan:
-    """Publish the plan of `revision` again, on a new writer: a robot has not taken it."""
-
-    revision: int
-
-
-Effect = Solve | PublishPlan | JobDone | Note | ResendPlan
-
-
-@dataclass(frozen=True)
-class StatusView:
-    mission_id: str
-    scenario: str
-    state: MissionState
-    revision: int
-    jobs_done: int
-    jobs_running: int
-    jobs_total: int
-    planned_makespan: float
-    projected_makespan: float
-    elapsed: float
-    blocked: tuple[str, ...]
-    replan_reasons: tuple[str, ...]
-    warnings: tuple[str, ...]
-    ignored: Counter
-    blocked_too_long: bool
-    """The mission failed because it stayed blocked beyond its `blocked_timeout`."""
 
 
 # --- what the controller keeps ---------------------------------------------------------
 
 @dataclass
-class _Agent:
-    """What is known of one robot's agent, across missions."""
-
-    report: RobotReport
-    heard: float
-    """Wall seconds of the latest state received."""
-    offline_since: float | None = None
-    back_since: float | None = None
-    """First report after an offline spell: it counts again a heartbeat timeout later."""
-    reachable_since: float = 0.0
-    """Wall seconds since when its agent could have received the latest plan: its first
-    report, its first after an offline spell or a restart."""
-
-
-class _RecentEvents:
-    """Ids of the latest task events received from one robot, oldest first."""
-
-    def __init__(self):
-        self._ids: dict[str, None] = {}
-
-    def add(self, event_id: str) -> None:
-        self._ids[event_id] = None
-        if len(self._ids) > EVENTS_REMEMBERED:
-            del self._ids[next(iter(self._ids))]
-
-    def __contains__(self, event_id: str) -> bool:
-        return event_id in self._ids
-
-
-@dataclass
-class _Solving:
+class Solving:
     token: int
-    kind: str
+    kind: SolveKind
     problem: Problem
     """What was posed: for a first plan, the problem the schedule will be of."""
     fleet: dict[str, tuple[int, int]]
@@ -274,21 +79,21 @@ class _Solving:
 
 
 @dataclass
-class _Mission:
+class Mission:
     id: str
     problem: Problem
     settings: Settings
     tracker: MissionTracker
     accepted: float
     """Wall seconds when the mission was accepted."""
-    state: MissionState = MissionState.WAITING_FOR_ROBOTS
+    _state: MissionState = INITIAL
     start: float | None = None
     """Wall seconds of schedule time 0, fixed when revision 1 is published."""
     schedule: Schedule | None = None
     planned_makespan: float = math.nan
     planned: dict[str, tuple[int, int]] = field(default_factory=dict)
     """The robots the current plan (or blocked verdict) counts on: (incarnation, failures)."""
-    solving: _Solving | None = None
+    solving: Solving | None = None
     replan_reasons: tuple[str, ...] = ()
     blocked: tuple[str, ...] = ()
     failure: tuple[str, ...] = ()
@@ -298,7 +103,7 @@ class _Mission:
     warned: set[str] = field(default_factory=set)
     pending: tuple[str, ...] = ()
     """Reasons of a re-plan still to make (one discarded or failed, jobs added, a restart)."""
-    improving: _Solving | None = None
+    improving: Solving | None = None
     """The search for a better plan than the repaired one in force, if any."""
     reports: int = 0
     """Task events used so far."""
@@ -321,16 +126,27 @@ class _Mission:
     """Robot -> the revision it did not take within `plan_uptake_timeout`: it is planned
     without until it reports the latest revision."""
 
+    @property
+    def state(self) -> MissionState:
+        return self._state
+
+    @property
+    def clock(self) -> ScheduleClock | None:
+        """The mission's schedule time, once revision 1 fixed its start (None before)."""
+        return None if self.start is None else ScheduleClock(self.start,
+                                                             self.settings.time_scale)
+
+    def enter(self, state: MissionState) -> None:
+        """Move the mission to `state`, as `states.TRANSITIONS` allows (else it raises)."""
+        self._state = check_transition(self._state, state)
+
 
 class MissionController:
-    def __init__(self, settings: Settings = Settings()):
-        self.settings = settings
-        self.agents: dict[str, _Agent] = {}
-        self.events_heard: dict[str, _RecentEvents] = {}
-        """Per robot (of the mission, or heard from), the task events received from it."""
-        self.mission: _Mission | None = None
+    def __init__(self, settings: Settings | None = None):
+        self.settings = settings if settings is not None else Settings()
+        self.liveness = Liveness()
+        self.mission: Mission | None = None
         self._tokens = 0
-        self._last_tick: float | None = None
 
     # --- commands ------------------------------------------------------------------------
 
@@ -340,8 +156,8 @@ class MissionController:
         if self.mission is not None and not self.mission.state.ended:
             raise ValueError(f"mission '{self.mission.id}' is {self.mission.state}: one "
                              'mission per fleet at a time')
-        self.mission = _Mission(mission_id, problem, settings or self.settings,
-                                MissionTracker(problem), wall)
+        self.mission = Mission(mission_id, problem, settings or self.settings,
+                               MissionTracker(problem), wall)
         robots = ', '.join(r.name for r in problem.robots)
         effects = [Note(MissionEventKind.MISSION_STARTED,
                         (f"scenario '{problem.name}': {len(problem.jobs)} jobs, robots "
@@ -354,7 +170,7 @@ class MissionController:
         if mission is None or mission.state.ended:
             raise ValueError('no mission is running')
         mission.solving = mission.improving = None
-        mission.state = MissionState.CANCELLED
+        mission.enter(MissionState.CANCELLED)
         mission.failure = (reason,)
         effects: list[Effect] = [Note(MissionEventKind.MISSION_CANCELLED, (reason,))]
         if mission.start is not None:
@@ -378,8 +194,8 @@ class MissionController:
         if mission.solving is not None:
             # Whatever is being solved leaves the new jobs out.
             mission.solving = None
-            mission.state = (MissionState.WAITING_FOR_ROBOTS if mission.schedule is None
-                             else MissionState.EXECUTING)
+            mission.enter(MissionState.WAITING_FOR_ROBOTS if mission.schedule is None
+                          else MissionState.EXECUTING)
         if mission.schedule is not None:
             mission.pending += (reason,)
         return effects + self.tick(wall)
@@ -391,26 +207,11 @@ class MissionController:
         reported and its event history has arrived (or the robot wait is over)."""
         if self.mission is not None and not self.mission.state.ended:
             raise ValueError(f"mission '{self.mission.id}' is {self.mission.state}")
-        starts = next((r.starts for r in reversed(records)
-                       if isinstance(r, PlanRecord) and r.starts), {})
-        if starts:
-            # The mission began where the robots were, not where the scenario starts them.
-            problem = replace(problem, robots=tuple(
-                replace(r, start_location=starts.get(r.name, r.start_location))
-                for r in problem.robots))
-        mission = _Mission(mission_id, problem, settings, MissionTracker(problem), wall,
-                           resumed=True)
+        problem = started_where(problem, records)
+        mission = Mission(mission_id, problem, settings, MissionTracker(problem), wall,
+                          resumed=True)
+        restore(mission, records, wall)
         tracker = mission.tracker
-        for record in records:
-            if isinstance(record, PlanRecord) and record.schedule is not None:
-                tracker.set_plan(record.schedule, record.revision, record.continued)
-                mission.schedule, mission.start = record.schedule, record.start
-                mission.planned_makespan = float(record.schedule.makespan)
-                mission.replan_reasons = record.reasons
-                mission.journaled = dict(record.incarnations)
-            elif isinstance(record, DoneRecord):
-                tracker.restore_done(record.assignment)
-        mission.published_at = wall
         self.mission = mission
         where = (f'at plan revision {tracker.revision}, {len(tracker.done)}/'
                  f'{len(tracker.jobs)} jobs done' if mission.schedule is not None
@@ -428,58 +229,23 @@ class MissionController:
             mission.resumed = False
             return self._plan(mission, wall)
         waited = wall - mission.accepted
-        behind = [r.name for r in mission.problem.robots if not self._caught_up(r.name)]
+        behind = [r.name for r in mission.problem.robots
+                  if not self.liveness.caught_up(r.name)]
         if behind and waited < self.settings.robot_wait_timeout:
             return []
         mission.resumed = False
-        effects = self._restarted_while_down(mission, wall)
-        mission.planned = self._fleet(mission, self._unavailable(mission, wall))
-        mission.state = MissionState.EXECUTING
+        effects = restarted_while_down(mission, self.liveness, self._units(mission, wall))
+        mission.planned = self._fleet(mission, wall)
+        mission.enter(MissionState.EXECUTING)
         mission.pending = ('planner restarted: what remains is re-planned from where the '
                            'robots are',)
         return effects
 
-    def _restarted_while_down(self, mission: _Mission, wall: float) -> list[Effect]:
-        """Agents that restarted while no planner ran: the operations their previous
-        processes had under way died with them. Their co-workers may have begun those jobs
-        with them, so the jobs are aborted and redone together, as when the planner sees a
-        restart itself. Told once the histories have arrived, so that every job begun is
-        known to have begun."""
-        effects: list[Effect] = []
-        for robot, planned in sorted(mission.journaled.items()):
-            agent = self.agents.get(robot)
-            if not planned or agent is None or agent.report.incarnation == planned:
-                continue
-            effects += [Note(MissionEventKind.JOB_ABORTED,
-                             (f"robot '{robot}' restarted while the planner was down: its "
-                              'agent lost the operation',), job=job)
-                        for job in mission.tracker.agent_restarted(
-                            robot, at=self._now(mission, wall))]
-        mission.journaled = {}
-        return effects
-
-    def _caught_up(self, robot: str) -> bool:
-        """Whether the latest event the robot says it published has been received (events
-        of one writer arrive in order, so all before it have too); true for a robot not
-        heard from."""
-        agent = self.agents.get(robot)
-        last = agent.report.last_event if agent is not None else ''
-        return not last or last in self.events_heard.get(robot, ())
-
     # --- what the fleet reports ----------------------------------------------------------
 
     def robot_state(self, report: RobotReport, wall: float) -> list[Effect]:
-        agent = self.agents.get(report.robot)
-        restarted = False
-        if agent is None:
-            agent = self.agents[report.robot] = _Agent(report, wall, reachable_since=wall)
-        else:
-            if agent.offline_since is not None and agent.back_since is None:
-                agent.back_since = agent.reachable_since = wall
-            restarted = report.incarnation != agent.report.incarnation
-            if restarted:
-                agent.reachable_since = wall
-            agent.report, agent.heard = report, wall
+        restarted = self.liveness.hear(report, wall)
+        agent = self.liveness.agents[report.robot]
         mission = self.mission
         if mission is None:
             return []
@@ -492,11 +258,11 @@ class MissionController:
                              (f"robot '{report.robot}' restarted: its agent lost the "
                               'operation',), job=job)
                         for job in mission.tracker.agent_restarted(
-                            report.robot, at=self._now(mission, wall))]
+                            report.robot, at=self._units(mission, wall))]
         if report.robot not in mission.tracker.robots:
-            outcome = mission.tracker.record_robot_state(report.robot, report.mode, '', '',
+            verdict = mission.tracker.record_robot_state(report.robot, report.mode, '', '',
                                                          math.nan)
-            if outcome.repeated:
+            if verdict.repeated:
                 return []
             return [Note(MissionEventKind.WARNING, (self._unknown(report.robot),),
                          robot=report.robot)]
@@ -504,13 +270,13 @@ class MissionController:
             return effects  # the tracker hears it again once it counts again
         return effects + self._record(mission, report, wall)
 
-    def _record(self, mission: _Mission, report: RobotReport, wall: float) -> list[Effect]:
+    def _record(self, mission: Mission, report: RobotReport, wall: float) -> list[Effect]:
         """Give the tracker a robot's report; the story of what changed."""
         effects: list[Effect] = []
         before = mission.tracker.robots[report.robot].mode
         mission.tracker.record_robot_state(report.robot, report.mode, report.location,
                                            report.destination, report.busy_until,
-                                           report.current_job, at=self._now(mission, wall))
+                                           report.current_job, at=self._units(mission, wall))
         if report.mode == RobotMode.FAILED and before != RobotMode.FAILED:
             effects.append(Note(MissionEventKind.ROBOT_FAILED, robot=report.robot))
         elif before == RobotMode.FAILED and report.mode != RobotMode.FAILED:
@@ -525,9 +291,9 @@ class MissionController:
     def task_event(self, event: EventReport, wall: float) -> tuple[list[Effect], str]:
         """Use one agent's event; the second item says why it was ignored ('' if used)."""
         mission = self.mission
-        if event.robot in self.agents or (mission is not None
-                                           and event.robot in mission.tracker.robots):
-            self.events_heard.setdefault(event.robot, _RecentEvents()).add(event.event_id)
+        if event.robot in self.liveness.agents or (mission is not None
+                                                    and event.robot in mission.tracker.robots):
+            self.liveness.hear_event(event.robot, event.event_id)
         if mission is None:
             return [], ''
         tracker = mission.tracker
@@ -543,18 +309,18 @@ class MissionController:
             return [], (f"job-done event '{event.event_id}': only the planner declares jobs "
                         'done')
         aborted_before = event.job in tracker.aborted
-        outcome = tracker.record_event(event.event_id, event.kind, event.robot, event.job,
+        verdict = tracker.record_event(event.event_id, event.kind, event.robot, event.job,
                                        event.revision, event.time)
-        if outcome.ignored:
-            return [], f'{outcome.ignored} event: {outcome.reason}'
+        if verdict.ignored:
+            return [], f'{verdict.ignored} event: {verdict.reason}'
         mission.reports += 1
         effects: list[Effect] = []
         if event.kind == EventKind.ABORTED and not aborted_before \
                 and event.job in tracker.aborted:
             effects.append(Note(MissionEventKind.JOB_ABORTED,
                                 (f"robot '{event.robot}' aborted it",), job=event.job))
-        if outcome.job_done is not None:
-            job, end = outcome.job_done
+        if verdict.job_done is not None:
+            job, end = verdict.job_done
             effects.append(JobDone(job, end, tracker.revision, tracker.jobs[job].done_as))
             if tracker.complete and not mission.state.ended:
                 effects += self._complete(mission)
@@ -565,8 +331,7 @@ class MissionController:
     def tick(self, wall: float, subscribers: int | None = None) -> list[Effect]:
         """Judge heartbeats, start what is due. `subscribers` counts the plan topic's
         matched readers: the first plan waits until every robot can hear it."""
-        starved = self._last_tick is not None and wall - self._last_tick > STARVED
-        self._last_tick = wall
+        starved = self.liveness.starved(wall)
         effects: list[Effect] = []
         if not starved:
             effects += self._check_heartbeats(wall)
@@ -575,7 +340,7 @@ class MissionController:
             return effects
         if mission.state == MissionState.WAITING_FOR_ROBOTS:
             waited = wall - mission.accepted
-            heard = all(self._heard(r.name) for r in mission.problem.robots)
+            heard = all(self.liveness.heard(r.name) for r in mission.problem.robots)
             unmatched = subscribers is not None and subscribers < len(mission.problem.robots)
             if (not heard or unmatched) and waited < self.settings.robot_wait_timeout:
                 return effects
@@ -584,7 +349,8 @@ class MissionController:
             return effects + self._resume_when_caught_up(mission, wall)
         if mission.state in (MissionState.EXECUTING, MissionState.BLOCKED):
             if not starved:
-                effects += self._check_uptake(mission, wall)
+                effects += self.liveness.check_uptake(mission, wall,
+                                                      self.settings.plan_uptake_timeout)
             reasons = self._replan_reasons(mission, wall)
             if mission.pending and (reasons or self._may_retry(mission, wall)):
                 reasons, mission.pending = list(mission.pending) + reasons, ()
@@ -603,7 +369,7 @@ class MissionController:
         return effects
 
     @staticmethod
-    def _may_retry(mission: _Mission, wall: float) -> bool:
+    def _may_retry(mission: Mission, wall: float) -> bool:
         if mission.retry is None:
             return True
         reports, failed_at = mission.retry
@@ -611,93 +377,36 @@ class MissionController:
 
     def _check_heartbeats(self, wall: float) -> list[Effect]:
         effects = []
-        timeout = self.settings.heartbeat_timeout
-        for name, agent in self.agents.items():
-            silent = wall - agent.heard
-            if agent.offline_since is None and silent > timeout:
-                agent.offline_since, agent.back_since = wall, None
-                if self.mission is not None and name in self.mission.tracker.robots:
-                    self.mission.tracker.mark_offline(name, at=self._now(self.mission, wall))
-                    effects.append(Note(MissionEventKind.ROBOT_OFFLINE,
-                                        (f'no state for {silent:.1f} s',), robot=name))
-            elif agent.back_since is not None and silent <= timeout \
-                    and wall - agent.back_since >= timeout:
-                agent.offline_since = agent.back_since = None
-                if self.mission is not None and name in self.mission.tracker.robots:
-                    effects.append(Note(MissionEventKind.ROBOT_BACK,
-                                        (f'reporting again ({agent.report.mode})',),
-                                        robot=name))
-                    effects += self._record(self.mission, agent.report, wall)
+        mission = self.mission
+        for change in self.liveness.check_heartbeats(wall, self.settings.heartbeat_timeout):
+            if mission is None or change.robot not in mission.tracker.robots:
+                continue
+            if not change.back:
+                mission.tracker.mark_offline(change.robot, at=self._units(mission, wall))
+                effects.append(Note(MissionEventKind.ROBOT_OFFLINE,
+                                    (f'no state for {change.silent:.1f} s',),
+                                    robot=change.robot))
+            else:
+                report = self.liveness.agents[change.robot].report
+                effects.append(Note(MissionEventKind.ROBOT_BACK,
+                                    (f'reporting again ({report.mode})',), robot=change.robot))
+                effects += self._record(mission, report, wall)
         return effects
-
-    def _check_uptake(self, mission: _Mission, wall: float) -> list[Effect]:
-        """Robots that report, but not the latest revision: the plan is published again
-        after PLAN_RESEND_AFTER, and they are planned without after `plan_uptake_timeout`,
-        until they report it."""
-        if mission.schedule is None or mission.published_at is None:
-            return []
-        revision, effects = mission.tracker.revision, []
-        for robot in mission.problem.robots:
-            agent = self.agents.get(robot.name)
-            if agent is None or agent.offline_since is not None:
-                continue
-            waited = wall - max(mission.published_at, agent.reachable_since)
-            report = agent.report
-            if report.refusal:
-                continue  # it has the plan, and says why it does not follow it
-            if report.mission_id == mission.id and report.revision >= revision:
-                mission.missed.pop(robot.name, None)
-                continue
-            if waited < PLAN_RESEND_AFTER:
-                continue
-            told = f'uptake {robot.name} {revision}'
-            if told not in mission.warned:
-                mission.warned.add(told)
-                effects.append(Note(MissionEventKind.WARNING, (
-                    f"robot '{robot.name}' has not taken plan revision {revision} for "
-                    f'{waited:.1f} s: published again',), robot=robot.name))
-            if mission.resent < revision:
-                mission.resent = revision
-                effects.append(ResendPlan(revision))
-            if waited >= self.settings.plan_uptake_timeout:
-                mission.missed.setdefault(robot.name, revision)
-        return effects
-
-    def _heard(self, robot: str) -> bool:
-        agent = self.agents.get(robot)
-        return agent is not None and agent.offline_since is None
 
     # --- solving ---------------------------------------------------------------------------
 
-    def _unavailable(self, mission: _Mission, wall: float) -> dict[str, str]:
+    def _unavailable(self, mission: Mission, wall: float) -> dict[str, str]:
         """Robot -> why it cannot take part in planning now ('' if it can)."""
-        why = {}
-        for robot in mission.problem.robots:
-            agent = self.agents.get(robot.name)
-            if agent is None:
-                why[robot.name] = (f'has not reported since the mission was accepted '
-                                   f'{wall - mission.accepted:.0f} s ago')
-            elif agent.offline_since is not None:
-                why[robot.name] = 'offline (heartbeat lost)'
-            elif agent.report.mode == RobotMode.FAILED:
-                why[robot.name] = 'failed'
-            elif agent.report.refusal:
-                why[robot.name] = f'refuses its plan: {agent.report.refusal}'
-            elif robot.name in mission.missed:
-                why[robot.name] = (f'has not taken plan revision {mission.missed[robot.name]} '
-                                   f'within {self.settings.plan_uptake_timeout:g} s')
-            else:
-                why[robot.name] = ''
-        return why
+        return self.liveness.unavailable(mission, wall, self.settings.plan_uptake_timeout)
 
-    def _fleet(self, mission: _Mission, unavailable: dict[str, str]) -> dict:
-        return {name: (self.agents[name].report.incarnation, self.agents[name].report.failures)
-                for name, why in unavailable.items() if not why}
+    def _fleet(self, mission: Mission, wall: float) -> dict[str, tuple[int, int]]:
+        """The robots available now: (incarnation, failures)."""
+        return self.liveness.fleet(self._unavailable(mission, wall))
 
-    def _plan(self, mission: _Mission, wall: float) -> list[Effect]:
+    def _plan(self, mission: Mission, wall: float) -> list[Effect]:
         """The first plan of the mission, for the robots available now, from where they are."""
         unavailable = self._unavailable(mission, wall)
-        fleet = self._fleet(mission, unavailable)
+        fleet = self.liveness.fleet(unavailable)
         problem = mission.problem
         state = self._initial_state(mission, fleet)
         if state is None:
@@ -709,10 +418,11 @@ class MissionController:
                 return self._block(mission, wall, tuple(residual.blocked)
                                    + self._missing(unavailable))
             posed = residual.problem
-        mission.state = MissionState.PLANNING
-        return [self._solve(mission, 'plan', fleet, (), posed, mission.settings.time_limit)]
+        mission.enter(MissionState.PLANNING)
+        return [self._solve(mission, SolveKind.PLAN, fleet, (), posed,
+                            mission.settings.time_limit)]
 
-    def _initial_state(self, mission: _Mission, fleet) -> ExecutionState | None:
+    def _initial_state(self, mission: Mission, fleet) -> ExecutionState | None:
         """Where the robots are at the mission start, when that is not simply what the
         scenario says: some robots are out, or the last mission left them somewhere the
         scenario knows."""
@@ -720,61 +430,60 @@ class MissionController:
         locations = set(problem.locations())
         robots, moved = {}, False
         for robot in problem.robots:
-            agent = self.agents.get(robot.name)
+            agent = self.liveness.agents.get(robot.name)
             at = agent.report.destination or agent.report.location if agent else ''
             location = robot.start_location
             if robot.name in fleet and at in locations and at != location:
                 location, moved = at, True
-            robots[robot.name] = RobotState(robot.name, robot.name in fleet, location,
+            robots[robot.name] = RobotSituation(robot.name, robot.name in fleet, location,
                                             robot.release_time)
         if not moved and len(fleet) == len(problem.robots):
             return None
         return ExecutionState(Fraction(0), frozenset(), {}, robots)
 
-    def _replan(self, mission: _Mission, wall: float, reasons: tuple[str, ...]
+    def _replan(self, mission: Mission, wall: float, reasons: tuple[str, ...]
                 ) -> list[Effect]:
-        unavailable = self._unavailable(mission, wall)
-        fleet = self._fleet(mission, unavailable)
+        fleet = self._fleet(mission, wall)
         try:
-            state = mission.tracker.execution_state(self._now(mission, wall))
+            state = mission.tracker.execution_state(self._units(mission, wall))
         except ValueError as error:
             mission.planned = fleet
             return self._block(mission, wall, (f'cannot tell the execution state: {error}',))
         # The tracker knows failed and offline robots; refusing and silent ones are out too.
         state = replace(state, robots={name: replace(robot, healthy=name in fleet)
                                        for name, robot in state.robots.items()})
-        mission.state = MissionState.REPLANNING
+        mission.enter(MissionState.REPLANNING)
         mission.improving = None  # a search from an older state would only be discarded
         limit = min(REPAIR_LIMIT, mission.settings.replan_time_limit)
-        return [self._solve(mission, 'repair', fleet, reasons, mission.problem, limit,
+        return [self._solve(mission, SolveKind.REPAIR, fleet, reasons, mission.problem, limit,
                             mission.schedule, state)]
 
     def _solve(self, mission, kind, fleet, reasons, problem, time_limit, previous=None,
                state=None) -> Solve:
         self._tokens += 1
-        mission.solving = _Solving(self._tokens, kind, problem, fleet, reasons, state)
+        mission.solving = Solving(self._tokens, kind, problem, fleet, reasons, state)
         return Solve(self._tokens, kind, problem, time_limit, previous, state, reasons)
 
-    def _improve(self, mission, solving: _Solving, published: Replan, wall: float,
+    def _improve(self, mission, solving: Solving, published: Replan, wall: float,
                  time_limit: float | None = None) -> Solve:
         """Search for a better plan from the one just published, while it is followed: the
         robots go on with what it has them do until the search's plan can reach them."""
         self._tokens += 1
         limit = time_limit or mission.settings.replan_time_limit
-        mission.improving = replace(solving, token=self._tokens, kind='improve',
+        mission.improving = replace(solving, token=self._tokens, kind=SolveKind.IMPROVE,
                                     time_limit=limit, published=published)
         # Robots start a job as soon as its robots and predecessors are ready, so they may
         # be ahead of the plan: what they started is kept too.
         started = frozenset(name for name, record in mission.tracker.jobs.items()
                             if record.begun)
-        return Solve(self._tokens, 'improve', published.residual.problem, limit,
+        return Solve(self._tokens, SolveKind.IMPROVE, published.residual.problem, limit,
                      state=solving.state, reasons=solving.reasons, published=published,
-                     frozen_until=self._now(mission, wall + limit + IMPROVE_REACH),
+                     frozen_until=self._units(mission, wall + limit + IMPROVE_REACH),
                      started=started)
 
     def solved(self, token: int, outcome, wall: float) -> list[Effect]:
-        """The outcome of `Solve` `token`: a `Result` ('plan'), a `Replan` ('replan'), or
-        the ValueError the solver raised. Outcomes of superseded solves are dropped."""
+        """The outcome of `Solve` `token` (what its `SolveKind` says), or the ValueError the
+        solver raised. Outcomes of superseded solves are dropped."""
         mission = self.mission
         if mission is not None and mission.improving is not None \
                 and mission.improving.token == token:
@@ -785,8 +494,8 @@ class MissionController:
         solving, mission.solving = mission.solving, None
         if mission.state.ended:
             return []
-        fleet_now = self._fleet(mission, self._unavailable(mission, wall))
-        if solving.kind == 'plan':
+        fleet_now = self._fleet(mission, wall)
+        if solving.kind == SolveKind.PLAN:
             return self._first_plan(mission, solving, outcome, wall, fleet_now)
         return self._new_revision(mission, solving, outcome, wall, fleet_now)
 
@@ -823,7 +532,7 @@ class MissionController:
             # The fleet changed while solving: this plan would give work to a robot that is
             # out, or leave out one that is back. The next tick re-plans from the new state,
             # for what this re-plan was for too.
-            mission.state = MissionState.EXECUTING
+            mission.enter(MissionState.EXECUTING)
             mission.pending = solving.reasons
             return [Note(MissionEventKind.WARNING,
                          ('re-plan discarded: the fleet changed while it was solved',))]
@@ -839,7 +548,7 @@ class MissionController:
         replanned: Replan = outcome
         residual = replanned.residual
         if residual.complete:
-            mission.state = MissionState.EXECUTING
+            mission.enter(MissionState.EXECUTING)
             return []
         if residual.blocked:
             return self._block(mission, wall, tuple(residual.blocked))
@@ -853,9 +562,10 @@ class MissionController:
                                                     for p in replanned.problems))
         continued = frozenset(residual.problem.fixed)
         progressed = self._progressed(mission, solving, residual.problem, wall)
-        if progressed and not self._goes_on(mission, result.schedule, progressed, continued):
+        if progressed and not continuation.goes_on(mission.tracker, result.schedule, progressed,
+                                                   continued):
             # Restarting these would redo work done meanwhile: plan again from now.
-            mission.state = MissionState.EXECUTING
+            mission.enter(MissionState.EXECUTING)
             mission.pending = solving.reasons
             return [Note(MissionEventKind.WARNING,
                          ('re-plan discarded: ' + ', '.join(f"job '{j}'" for j in progressed)
@@ -864,14 +574,14 @@ class MissionController:
                       revision=mission.tracker.revision) for job in residual.voided]
         mission.blocked, mission.blocked_since = (), None
         continued |= frozenset(progressed)
-        continued |= self._unchanged(mission, result.schedule, continued)
+        continued |= continuation.unchanged(mission.tracker, result.schedule, continued)
         published = self._publish(mission, residual.problem, result, continued,
                                   solving.reasons, wall)
         if result.status == Status.OPTIMAL:
             return notes + published
         return notes + published + [self._improve(mission, solving, replanned, wall)]
 
-    def _improved(self, mission, solving: _Solving, outcome, wall: float) -> list[Effect]:
+    def _improved(self, mission, solving: Solving, outcome, wall: float) -> list[Effect]:
         """A better plan than the repaired one, published as the next revision if it beats
         it by the improvement margin, nothing changed in the fleet meanwhile, and what the
         robots did since goes on as it is in it; then searched from again. A search that
@@ -882,7 +592,7 @@ class MissionController:
         is shorter by the margin, so agents do not thrash."""
         if isinstance(outcome, Exception) or mission.state != MissionState.EXECUTING:
             return []
-        if self._fleet(mission, self._unavailable(mission, wall)) != solving.fleet:
+        if self._fleet(mission, wall) != solving.fleet:
             return []
         if not outcome.improved:
             kept = outcome.replan.result
@@ -892,7 +602,8 @@ class MissionController:
         better = outcome.replan
         continued = frozenset(better.residual.problem.fixed)
         progressed = self._progressed(mission, solving, better.residual.problem, wall)
-        if progressed and not self._goes_on(mission, better.schedule, progressed, continued):
+        if progressed and not continuation.goes_on(mission.tracker, better.schedule,
+                                                   progressed, continued):
             # The robots got further than the search kept: the plan cannot be followed.
             dropped = Note(MissionEventKind.WARNING, (
                 f'a better plan (makespan {float(better.result.makespan):.2f}) dropped: '
@@ -902,7 +613,7 @@ class MissionController:
         reason = (f'a better plan: makespan {mission.planned_makespan:.2f} -> '
                   f'{float(better.result.makespan):.2f}')
         continued |= frozenset(progressed)
-        continued |= self._unchanged(mission, better.schedule, continued)
+        continued |= continuation.unchanged(mission.tracker, better.schedule, continued)
         published = self._publish(mission, better.residual.problem, better.result, continued,
                                   (reason,), wall)
         if better.result.status == Status.OPTIMAL:
@@ -910,7 +621,7 @@ class MissionController:
         return published + [self._improve(mission, solving, better, wall,
                                           solving.time_limit)]
 
-    def _search_longer(self, mission, solving: _Solving, published: Replan, wall: float
+    def _search_longer(self, mission, solving: Solving, published: Replan, wall: float
                        ) -> list[Effect]:
         """After a search that gave no plan to publish: one twice as long from `published`,
         up to LONGEST_SEARCH times `replan_time_limit`."""
@@ -919,91 +630,11 @@ class MissionController:
             return []
         return [self._improve(mission, solving, published, wall, longer)]
 
-    def _progressed(self, mission, solving: _Solving, posed: Problem, wall: float
+    def _progressed(self, mission, solving: Solving, posed: Problem, wall: float
                     ) -> list[str]:
-        """Jobs the new plan starts afresh that started or completed since it was posed, or
-        whose start fell due within the last DUE_GRACE seconds: their robots, all available
-        when it was posed and none failed or restarted since the current plan, start them
-        on reports the planner has too, so their start reports are on their way."""
-        tracker = mission.tracker
-        recent = self._now(mission, wall) - DUE_GRACE / mission.settings.time_scale
-        shaken = tracker.failed_since(tracker.revision)
-        moved = []
-        for job in posed.jobs:
-            if job.name in posed.fixed:
-                continue
-            if job.name in solving.state.running or job.name in solving.state.done:
-                continue
-            if tracker.jobs[job.name].begun:
-                moved.append(job.name)
-                continue
-            due = tracker.due_start(job.name)
-            if due is None or due < recent:
-                continue
-            robots = tracker.plan.jobs[job.name].robots
-            if not shaken & set(robots) and all(r in solving.fleet for r in robots):
-                moved.append(job.name)
-        return moved
-
-    def _goes_on(self, mission, schedule: Schedule, progressed, continued) -> bool:
-        """Whether the new plan can let the jobs that progressed while it was solved go on
-        as they are (continued, not redone): it gives each the plan and robots it runs with,
-        and each of those robots does them first, in the order it began them, before any
-        job the plan starts afresh — so every robot's next leg leaves from where it is."""
-        tracker = mission.tracker
-        order = sorted(progressed, key=lambda job: tracker.jobs[job].start
-                       if tracker.jobs[job].begun else tracker.due_start(job))
-        for job in order:
-            running, new = tracker.plan.jobs[job], schedule.jobs.get(job)
-            if new is None or new.plan != running.plan \
-                    or dict(new.robots) != dict(running.robots):
-                return False
-        for robot in {r for job in order for r in tracker.plan.jobs[job].robots}:
-            mine = [job for job in order if robot in tracker.plan.jobs[job].robots]
-            fresh = [job for job in schedule.sequences.get(robot, ()) if job not in continued]
-            if fresh[:len(mine)] != mine:
-                return False
-        return True
-
-    def _unchanged(self, mission, schedule: Schedule, continued) -> frozenset[str]:
-        """Jobs not begun that the new plan leaves as the old one had them: the same plan and
-        robots, none of which failed or restarted since the old plan, and for each of those
-        robots next in both the old and the new order, after what goes on. They go on rather
-        than start afresh: a robot may have arrived at one, or started it, on reports still
-        on their way to the planner, and starting it afresh would void those arrivals and
-        have its robots do it twice."""
-        tracker = mission.tracker
-        old = tracker.plan
-        # What a robot that failed or restarted since reported no longer holds.
-        shaken = tracker.failed_since(tracker.revision)
-
-        def same(job: str) -> bool:
-            was, new, record = old.jobs.get(job), schedule.jobs.get(job), tracker.jobs[job]
-            return (was is not None and new is not None and not record.begun
-                    and not record.aborted and new.plan == was.plan
-                    and dict(new.robots) == dict(was.robots) and not shaken & set(new.robots))
-
-        heads = {}
-        for robot, sequence in schedule.sequences.items():
-            # A job begun and started afresh is still ahead of its robots in both orders.
-            before = [job for job in old.sequences.get(robot, ())
-                      if job not in continued and tracker.jobs[job].end is None]
-            after = [job for job in sequence if job not in continued]
-            head = []
-            for a, b in zip(before, after, strict=False):
-                if a != b or not same(a):
-                    break
-                head.append(a)
-            heads[robot] = head
-        while True:
-            kept = {job for head in heads.values() for job in head
-                    if all(job in heads.get(r, ()) for r in schedule.jobs[job].robots)}
-            cut = {robot: head[:next((i for i, job in enumerate(head) if job not in kept),
-                                     len(head))]
-                   for robot, head in heads.items()}
-            if cut == heads:
-                return frozenset(kept)
-            heads = cut
+        """`continuation.progressed` for the plan `solving` gave."""
+        return continuation.progressed(mission.tracker, posed, solving.state, solving.fleet,
+                                       self._units(mission, wall), mission.settings.time_scale)
 
     def _publish(self, mission, posed, result, continued, reasons, wall) -> list[Effect]:
         tracker = mission.tracker
@@ -1013,7 +644,7 @@ class MissionController:
         mission.schedule = result.schedule
         mission.planned_makespan = float(result.makespan)
         mission.replan_reasons = reasons
-        mission.state = MissionState.EXECUTING
+        mission.enter(MissionState.EXECUTING)
         starts = {r.name: r.start_location for r in mission.problem.robots}
         incarnations = {name: planned[0] for name, planned in mission.planned.items()}
         restarted_in = {job: tracker.jobs[job].since_revision for job in result.schedule.jobs}
@@ -1022,13 +653,13 @@ class MissionController:
                             starts=starts),
                 Note(MissionEventKind.PLAN_PUBLISHED, reasons)]
 
-    def _next_revision(self, mission: _Mission) -> int:
+    def _next_revision(self, mission: Mission) -> int:
         """Above any revision a robot follows: after a restart, the journal may lag them."""
-        followed = [a.report.revision for a in self.agents.values()
+        followed = [a.report.revision for a in self.liveness.agents.values()
                     if a.report.mission_id == mission.id]
         return max([mission.tracker.revision, *followed]) + 1
 
-    def _replan_reasons(self, mission: _Mission, wall: float) -> list[str]:
+    def _replan_reasons(self, mission: Mission, wall: float) -> list[str]:
         """Why the current plan (or blocked verdict) no longer fits the fleet; empty if it
         does. Late and aborted operations count only while executing: a blocked mission
         waits for a robot to come back."""
@@ -1040,7 +671,7 @@ class MissionController:
             elif planned is None and not why:
                 reasons.append(f"robot '{name}' available")
             elif planned is not None:
-                report = self.agents[name].report
+                report = self.liveness.agents[name].report
                 if report.incarnation != planned[0]:
                     reasons.append(f"robot '{name}' restarted: its agent lost its tasks")
                 elif report.failures != planned[1]:
@@ -1056,7 +687,7 @@ class MissionController:
     def _block(self, mission, wall, reasons) -> list[Effect]:
         """Nothing can be planned until the fleet changes; the current plan stays, so the
         robots finish what they can of it."""
-        mission.state = MissionState.BLOCKED
+        mission.enter(MissionState.BLOCKED)
         if mission.blocked_since is None:
             mission.blocked_since = wall
         effects = []
@@ -1069,7 +700,7 @@ class MissionController:
         return tuple(f"robot '{name}' {why}" for name, why in unavailable.items() if why)
 
     def _fail(self, mission, reasons) -> list[Effect]:
-        mission.state = MissionState.FAILED
+        mission.enter(MissionState.FAILED)
         mission.failure = reasons
         return [Note(MissionEventKind.MISSION_FAILED, reasons)]
 
@@ -1079,7 +710,7 @@ class MissionController:
         violations = mission.tracker.violations()
         if violations:
             return self._fail(mission, tuple(f'executed timeline: {v}' for v in violations))
-        mission.state = MissionState.COMPLETE
+        mission.enter(MissionState.COMPLETE)
         # A mission blocked for want of robots can still complete on the plan it had.
         mission.blocked, mission.blocked_since = (), None
         executed = float(mission.tracker.projected_makespan(0))
@@ -1089,14 +720,15 @@ class MissionController:
 
     # --- views -----------------------------------------------------------------------------
 
-    def _now(self, mission: _Mission, wall: float) -> float:
-        """Schedule time since the mission start (negative before it, 0 without a plan)."""
-        if mission.start is None:
-            return 0.0
-        return (wall - mission.start) / mission.settings.time_scale
+    @staticmethod
+    def _units(mission: Mission, wall: float) -> float:
+        """Schedule time at `wall` (negative before the mission start, 0 without a plan)."""
+        clock = mission.clock
+        return 0.0 if clock is None else clock.units(wall)
 
     def now_units(self, wall: float) -> float:
-        return 0.0 if self.mission is None else self._now(self.mission, wall)
+        """The running mission's schedule time at `wall` (0 without a mission or a plan)."""
+        return 0.0 if self.mission is None else self._units(self.mission, wall)
 
     def _unknown(self, robot: str) -> str:
         return (f"agent of robot '{robot}' is running, but scenario "
@@ -1111,7 +743,7 @@ class MissionController:
             if why and mission.state != MissionState.WAITING_FOR_ROBOTS:
                 warnings.append(f"robot '{name}' {why}")
         timeout = self.settings.heartbeat_timeout
-        for name, agent in sorted(self.agents.items()):
+        for name, agent in sorted(self.liveness.agents.items()):
             if name not in mission.tracker.robots and wall - agent.heard <= timeout:
                 warnings.append(self._unknown(name))
         return tuple(warnings)
@@ -1121,18 +753,19 @@ class MissionController:
         if mission is None:
             return None
         tracker = mission.tracker
-        now = self._now(mission, wall)
+        now_units = self._units(mission, wall)
         blocked = mission.blocked
         if mission.state == MissionState.WAITING_FOR_ROBOTS:
             blocked = tuple(f"waiting for robot '{r.name}' to report"
-                            for r in mission.problem.robots if not self._heard(r.name))
+                            for r in mission.problem.robots
+                            if not self.liveness.heard(r.name))
         elif mission.state in (MissionState.FAILED, MissionState.CANCELLED):
             blocked = mission.failure
-        projected = float(tracker.projected_makespan(now)) if tracker.plan else math.nan
+        projected = float(tracker.projected_makespan(now_units)) if tracker.plan else math.nan
         return StatusView(
             mission.id, mission.problem.name, mission.state, tracker.revision,
             len(tracker.done), len(tracker.running), len(tracker.jobs),
-            mission.planned_makespan, projected, max(now, 0.0), blocked,
+            mission.planned_makespan, projected, max(now_units, 0.0), blocked,
             mission.replan_reasons, self.warnings(wall), Counter(tracker.ignored),
             mission.blocked_too_long)
 
