@@ -47,6 +47,17 @@ def progressed(tracker: MissionTracker, posed: Problem, state: ExecutionState,
     return moved
 
 
+def completed_after_all(tracker: MissionTracker, posed: Problem, state: ExecutionState
+                        ) -> list[str]:
+    """Jobs running when the new plan was posed, which it starts afresh (their robot had
+    failed), that completed since: the robot finished its operation before it failed, and
+    its report came after its failure (states and events travel apart). The new plan would
+    have the job done twice."""
+    return [job.name for job in posed.jobs
+            if job.name in state.running and job.name not in posed.fixed
+            and tracker.jobs[job.name].end is not None]
+
+
 def goes_on(tracker: MissionTracker, schedule: Schedule, progressed, continued) -> bool:
     """Whether the new plan can let the jobs that progressed while it was solved go on
     as they are (continued, not redone): it gives each the plan and robots it runs with,

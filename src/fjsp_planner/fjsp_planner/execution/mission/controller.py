@@ -560,16 +560,15 @@ class MissionController:
         if replanned.problems:
             return self._block(mission, wall, tuple(f're-planned schedule is invalid: {p}'
                                                     for p in replanned.problems))
+        completed = continuation.completed_after_all(mission.tracker, residual.problem,
+                                                     solving.state)
+        if completed:
+            return self._discard(mission, solving, completed, 'completed')
         continued = frozenset(residual.problem.fixed)
         progressed = self._progressed(mission, solving, residual.problem, wall)
         if progressed and not continuation.goes_on(mission.tracker, result.schedule, progressed,
                                                    continued):
-            # Restarting these would redo work done meanwhile: plan again from now.
-            mission.enter(MissionState.EXECUTING)
-            mission.pending = solving.reasons
-            return [Note(MissionEventKind.WARNING,
-                         ('re-plan discarded: ' + ', '.join(f"job '{j}'" for j in progressed)
-                          + ' progressed while it was solved',))]
+            return self._discard(mission, solving, progressed, 'progressed')
         notes = [Note(MissionEventKind.JOB_VOIDED, ('its hold was lost',), job=job,
                       revision=mission.tracker.revision) for job in residual.voided]
         mission.blocked, mission.blocked_since = (), None
@@ -580,6 +579,15 @@ class MissionController:
         if result.status == Status.OPTIMAL:
             return notes + published
         return notes + published + [self._improve(mission, solving, replanned, wall)]
+
+    @staticmethod
+    def _discard(mission, solving: Solving, jobs, how: str) -> list[Effect]:
+        """Drop a re-plan that would redo work done meanwhile: plan again from now."""
+        mission.enter(MissionState.EXECUTING)
+        mission.pending = solving.reasons
+        return [Note(MissionEventKind.WARNING,
+                     ('re-plan discarded: ' + ', '.join(f"job '{j}'" for j in jobs)
+                      + f' {how} while it was solved',))]
 
     def _improved(self, mission, solving: Solving, outcome, wall: float) -> list[Effect]:
         """A better plan than the repaired one, published as the next revision if it beats
