@@ -1,5 +1,6 @@
-"""Defects the soak test (test_soak.py) found among random faults, each made into a test of
-its own that reproduces it on purpose."""
+"""Restarts in the middle of a mission: a planner killed just after declaring a job done, an
+agent killed while the planner is down, an agent restarted mid-job, a planner resuming after
+an earlier mission. Nothing is done twice, nothing is lost."""
 
 import time
 
