@@ -324,7 +324,7 @@ def test_interface_show_names_a_bad_type(share, name, error):
     (['interface', 'show', 'cell/Robot'], 1,
      "ros2 interface show: 'cell/Robot' is not an interface type name"),
     (['pkg', 'executables', 'no_such_package'], 1,
-     "ros2 pkg executables: package 'no_such_package' not found"),
+     "ros2 pkg executables: Package 'no_such_package' not found"),
     (['service', 'call', '/x', 'geometry_msgs/srv/Nope'], 1,
      "ros2 service call: unknown service type 'geometry_msgs/srv/Nope'"),
     (['topic', 'pub', '/x', 'geometry_msgs/msg/Twist', '{linear: 1}'], 1,

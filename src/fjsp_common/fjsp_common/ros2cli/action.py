@@ -11,15 +11,15 @@ from rclpy.action.graph import (
 )
 
 from .graph import (
-    LISTING_SPIN_TIME,
     LOOKUP_SPIN_TIME,
     CommandError,
+    add_list_verb,
     add_spin_time,
     answer,
     cli_node,
     described,
-    discover,
     full_name,
+    print_listing,
     spin_until,
 )
 from .messages import fill, interface_class, parse_values, to_yaml
@@ -58,12 +58,7 @@ def main(argv) -> int:
     parser = argparse.ArgumentParser(prog='ros2 action',
                                      description='Inspect and use the actions of the graph.')
     verbs = parser.add_subparsers(dest='verb', required=True, metavar='{list,info,send_goal}')
-    listing = verbs.add_parser('list', help='print the actions of the graph')
-    listing.add_argument('-t', '--show-types', action='store_true',
-                         help="also print each action's type")
-    listing.add_argument('-c', '--count-actions', action='store_true',
-                         help='print only how many actions there are')
-    add_spin_time(listing, LISTING_SPIN_TIME)
+    add_list_verb(verbs, 'actions', '--count-actions')
     info = verbs.add_parser('info', help="print an action's clients and servers")
     info.add_argument('action_name', help='e.g. /run_mission')
     info.add_argument('-t', '--show-types', action='store_true', help='also print their types')
@@ -83,13 +78,7 @@ def main(argv) -> int:
         request = fill(action_type.Goal(), parse_values(args.goal))
     with cli_node() as node:
         if args.verb == 'list':
-            actions = discover(node, lambda: sorted(get_action_names_and_types(node)),
-                               args.spin_time)
-            if args.count_actions:
-                print(len(actions))
-            for name, types in [] if args.count_actions else actions:
-                print(f"{name} [{', '.join(types)}]" if args.show_types else name)
-            return 0
+            return print_listing(node, args, lambda: get_action_names_and_types(node))
         name = node.resolve_topic_name(args.action_name)
         if args.verb == 'info':
             users = [[], []]

@@ -29,14 +29,43 @@ class CommandError(Exception):
     """What stops a command: one line for the user that names what was wrong."""
 
 
+def add_list_verb(verbs, things: str, count_option: str, hidden_option: str | None = None):
+    """`<command> list` as ros2cli has it for topics, services and actions: -t for the
+    types, -c for how many, -a for hidden ones too (where they can be hidden)."""
+    listing = verbs.add_parser('list', help=f'print the {things} of the graph')
+    listing.add_argument('-t', '--show-types', action='store_true',
+                         help="also print each one's type")
+    listing.add_argument('-c', count_option, dest='count', action='store_true',
+                         help=f'print only how many {things} there are')
+    if hidden_option:
+        listing.add_argument('-a', hidden_option, dest='include_hidden', action='store_true',
+                             help=f'hidden {things} too')
+    else:
+        listing.set_defaults(include_hidden=True)
+    add_spin_time(listing, LISTING_SPIN_TIME)
+    return listing
+
+
+def print_listing(node, args, names_and_types: Callable[[], list]) -> int:
+    """What a `list` verb prints: each name (with its types, `-t`), or how many (`-c`)."""
+    entries = [(name, types) for name, types in discover(
+        node, lambda: sorted(names_and_types()), args.spin_time)
+        if args.include_hidden or not is_hidden(name)]
+    if args.count:
+        print(len(entries))
+    for name, types in [] if args.count else entries:
+        print(f"{name} [{', '.join(types)}]" if args.show_types else name)
+    return 0
+
+
 def add_spin_time(parser, default: float) -> None:
     what = ('seconds to wait for discovery' if default == LISTING_SPIN_TIME
             else 'seconds to wait at most for it to be discovered')
-    parser.add_argument('--spin-time', type=_seconds, default=default, metavar='S',
+    parser.add_argument('--spin-time', type=seconds, default=default, metavar='S',
                         help=f'{what} (default {default:g})')
 
 
-def _seconds(text: str) -> float:
+def seconds(text: str) -> float:
     try:
         value = float(text)
     except ValueError:

@@ -29,7 +29,7 @@ def package_prefix(package: str) -> str:
     try:
         return get_package_prefix(package)
     except (PackageNotFoundError, LookupError, ValueError):
-        raise CommandError(f"package '{package}' not found") from None
+        raise CommandError(f"Package '{package}' not found") from None
 
 
 def run(argv) -> int:
@@ -39,8 +39,8 @@ def run(argv) -> int:
     package, executable, rest = argv[0], argv[1], argv[2:]
     prefix = package_prefix(package)
     if executable not in executables(prefix, package):
-        raise CommandError(f"package '{package}' has no executable '{executable}' (see "
-                           f'`ros2 pkg executables {package}`)')
+        raise CommandError(f"No executable found: '{executable}' is not one of package "
+                           f"'{package}' (see `ros2 pkg executables {package}`)")
     path = os.path.join(prefix, 'lib', package, executable)
     sys.stdout.flush()
     # Replace this process, as ros2cli's run does, so signals reach the node directly.

@@ -16,15 +16,15 @@ from rclpy.qos import (
 )
 
 from .graph import (
-    LISTING_SPIN_TIME,
     LOOKUP_SPIN_TIME,
     CommandError,
+    add_list_verb,
     add_spin_time,
     cli_node,
     described,
-    discover,
     find_types,
-    is_hidden,
+    print_listing,
+    seconds,
     spin_for,
     spin_until,
 )
@@ -78,12 +78,7 @@ def main(argv) -> int:
                                      description='Inspect and publish the topics of the graph.')
     verbs = parser.add_subparsers(dest='verb', required=True,
                                   metavar='{list,echo,info,hz,pub}')
-    listing = verbs.add_parser('list', help='print the topics of the graph')
-    listing.add_argument('-t', '--show-types', action='store_true',
-                         help="also print each topic's type")
-    listing.add_argument('-a', '--include-hidden-topics', action='store_true',
-                         help='hidden topics too')
-    add_spin_time(listing, LISTING_SPIN_TIME)
+    add_list_verb(verbs, 'topics', '--count-topics', '--include-hidden-topics')
     echo = verbs.add_parser('echo', help='print the messages of a topic')
     echo.add_argument('topic_name', help='e.g. /mission_status')
     echo.add_argument('message_type', nargs='?',
@@ -117,26 +112,21 @@ def main(argv) -> int:
     pub.add_argument('-w', '--wait-matching-subscriptions', type=int, metavar='N',
                      help='subscriptions to wait for before publishing (default 1 with --once '
                           'or --times, else 0)')
-    pub.add_argument('--keep-alive', type=float, default=0.1, metavar='S',
+    pub.add_argument('--keep-alive', type=seconds, default=0.1, metavar='S',
                      help='seconds to stay after the last message, for it to be delivered')
     pub.add_argument('--qos-reliability', choices=('reliable', 'best_effort'),
                      default='reliable')
     pub.add_argument('--qos-durability', choices=('volatile', 'transient_local'),
                      default='volatile')
     pub.add_argument('--qos-depth', type=_positive_int, default=10, metavar='N')
-    for verb, default in ((echo, LOOKUP_SPIN_TIME), (info, LOOKUP_SPIN_TIME),
-                          (hz, LOOKUP_SPIN_TIME), (pub, LOOKUP_SPIN_TIME)):
-        add_spin_time(verb, default)
+    for verb in (echo, info, hz, pub):
+        add_spin_time(verb, LOOKUP_SPIN_TIME)
     args = parser.parse_args(argv)
     if args.verb == 'pub':
         message = fill(interface_class(args.message_type, 'msg')(), parse_values(args.values))
     with cli_node() as node:
         if args.verb == 'list':
-            for name, types in discover(
-                    node, lambda: sorted(node.get_topic_names_and_types()), args.spin_time):
-                if args.include_hidden_topics or not is_hidden(name):
-                    print(f"{name} [{', '.join(types)}]" if args.show_types else name)
-            return 0
+            return print_listing(node, args, node.get_topic_names_and_types)
         name = node.resolve_topic_name(args.topic_name)
         if args.verb == 'pub':
             return _pub(node, name, message, args)
