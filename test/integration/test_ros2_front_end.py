@@ -237,3 +237,19 @@ def test_node_and_topic_info(fleet):
     assert topic.stdout.startswith('Type: fjsp_msgs/msg/Plan\n\nPublisher count: 1\n\n'
                                    'Node name: planner\n'), topic.stdout
     assert 'Durability: TRANSIENT_LOCAL' in topic.stdout
+
+
+@pytest.mark.parametrize('args, code', [
+    (('topic', 'echo', '/front_end_quiet', 'std_msgs/msg/String'), 0),  # nothing published
+    (('topic', 'hz', '/robot_states'), 0),
+    (('topic', 'pub', '/front_end_quiet', 'std_msgs/msg/String', '{data: x}', '-r', '5'), 0),
+    (('param', 'get', '/nope', 'x', '--spin-time', '60'), 130),  # interrupted while waiting
+])
+def test_ctrl_c_ends_quietly(fleet, args, code):
+    process = subprocess.Popen(['ros2', *args], env=fleet.env, text=True,
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    time.sleep(4)
+    process.send_signal(signal.SIGINT)
+    out, err = process.communicate(timeout=30)
+    assert process.returncode == code, (out, err)
+    assert err == '', err

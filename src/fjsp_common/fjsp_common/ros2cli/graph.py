@@ -61,11 +61,12 @@ def print_listing(node, args, names_and_types: Callable[[], list]) -> int:
 def add_spin_time(parser, default: float) -> None:
     what = ('seconds to wait for discovery' if default == LISTING_SPIN_TIME
             else 'seconds to wait at most for it to be discovered')
-    parser.add_argument('--spin-time', type=seconds, default=default, metavar='S',
+    parser.add_argument('--spin-time', type=seconds_argument, default=default, metavar='S',
                         help=f'{what} (default {default:g})')
 
 
-def seconds(text: str) -> float:
+def seconds_argument(text: str) -> float:
+    """argparse's type for a number of seconds: finite and >= 0."""
     try:
         value = float(text)
     except ValueError:
@@ -144,8 +145,7 @@ def answer(node, future, what: str, seconds: float = ANSWER_TIMEOUT):
     return future.result()
 
 
-def is_hidden(name: str) -> bool:
-    return topic_or_service_is_hidden(name)
+is_hidden = topic_or_service_is_hidden
 
 
 def full_name(name: str, namespace: str) -> str:

@@ -11,7 +11,7 @@ from .graph import (
     cli_node,
     find_types,
     print_listing,
-    seconds,
+    seconds_argument,
 )
 from .messages import fill, interface_class, parse_values
 
@@ -29,7 +29,7 @@ def main(argv) -> int:
     call.add_argument('service_type', help='e.g. fjsp_msgs/srv/InjectFault')
     call.add_argument('values', nargs='?', default='{}',
                       help="the request's fields in YAML, e.g. '{fault: 0}' (default: {})")
-    call.add_argument('--timeout', type=seconds, default=30.0, metavar='S',
+    call.add_argument('--timeout', type=seconds_argument, default=30.0, metavar='S',
                       help='seconds to wait for the response (default 30)')
     add_spin_time(call, LOOKUP_SPIN_TIME)
     args = parser.parse_args(argv)

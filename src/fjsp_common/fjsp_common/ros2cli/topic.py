@@ -24,7 +24,7 @@ from .graph import (
     described,
     find_types,
     print_listing,
-    seconds,
+    seconds_argument,
     spin_for,
     spin_until,
 )
@@ -112,7 +112,7 @@ def main(argv) -> int:
     pub.add_argument('-w', '--wait-matching-subscriptions', type=int, metavar='N',
                      help='subscriptions to wait for before publishing (default 1 with --once '
                           'or --times, else 0)')
-    pub.add_argument('--keep-alive', type=seconds, default=0.1, metavar='S',
+    pub.add_argument('--keep-alive', type=seconds_argument, default=0.1, metavar='S',
                      help='seconds to stay after the last message, for it to be delivered')
     pub.add_argument('--qos-reliability', choices=('reliable', 'best_effort'),
                      default='reliable')
@@ -128,9 +128,15 @@ def main(argv) -> int:
         if args.verb == 'list':
             return print_listing(node, args, node.get_topic_names_and_types)
         name = node.resolve_topic_name(args.topic_name)
-        if args.verb == 'pub':
-            return _pub(node, name, message, args)
-        return {'echo': _echo, 'info': _info, 'hz': _hz}[args.verb](node, name, args)
+        if args.verb == 'info':
+            return _info(node, name, args)
+        try:
+            if args.verb == 'pub':
+                return _pub(node, name, message, args)
+            return {'echo': _echo, 'hz': _hz}[args.verb](node, name, args)
+        except KeyboardInterrupt:
+            # Ctrl-C is how echo, hz and pub end, whether they got going or not.
+            return 0
 
 
 def _positive_int(text: str) -> int:
@@ -181,10 +187,7 @@ def _echo(node, name: str, args) -> int:
         received.append(msg)
 
     node.create_subscription(message_type, name, show, qos)
-    try:
-        spin_until(node, lambda: args.once and bool(received), math.inf)
-    except KeyboardInterrupt:
-        pass
+    spin_until(node, lambda: args.once and bool(received), math.inf)
     return 0
 
 
@@ -223,15 +226,12 @@ def _hz(node, name: str, args) -> int:
     node.create_subscription(message_type, name, lambda _: window.add(time.monotonic()),
                              qos_profile_sensor_data)
     started, shown = time.monotonic(), False
-    try:
-        while args.duration is None or time.monotonic() - started < args.duration:
-            spin_for(node, min(0.1, _left(started, args.duration)))
-            line = window.report()
-            if line:
-                print(line, flush=True)
-                shown = True
-    except KeyboardInterrupt:
-        return 0
+    while args.duration is None or time.monotonic() - started < args.duration:
+        spin_for(node, min(0.1, _left(started, args.duration)))
+        line = window.report()
+        if line:
+            print(line, flush=True)
+            shown = True
     if not shown:
         line = window.report(force=True)
         if line is None:
@@ -262,16 +262,13 @@ def _pub(node, name: str, message, args) -> int:
                                '(-w 0 publishes without waiting)')
     print('publisher: beginning loop', flush=True)
     count, started = 0, time.monotonic()
-    try:
-        while True:
-            count += 1
-            if args.print_nth and count % args.print_nth == 0:
-                print(f'publishing #{count}: {message!r}\n', flush=True)
-            publisher.publish(message)
-            if times and count >= times:
-                break
-            time.sleep(max(0.0, started + count / args.rate - time.monotonic()))
-        time.sleep(args.keep_alive)
-    except KeyboardInterrupt:
-        pass
+    while True:
+        count += 1
+        if args.print_nth and count % args.print_nth == 0:
+            print(f'publishing #{count}: {message!r}\n', flush=True)
+        publisher.publish(message)
+        if times and count >= times:
+            break
+        time.sleep(max(0.0, started + count / args.rate - time.monotonic()))
+    time.sleep(args.keep_alive)
     return 0
