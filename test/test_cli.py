@@ -199,3 +199,75 @@ def test_signals_stop_it_at_once_with_one_line(signum, panels, ready, stage, to_
     if stage is not None:
         assert stderr.strip().endswith(stage), stderr
     assert waited < 10, f'took {waited:.1f} s to stop'   # the time limit is 120 s
+
+
+LONG = 'x' * 24
+LONG_NAMES = f"""
+name: long names
+operation_types: {{0: grip and hold the {LONG}, 1: travel}}
+robot_types:
+  Crane: {{grip and hold the {LONG}: 2, travel: 10}}
+robots:
+  - {{name: crane_number_one_of_the_{LONG[:6]}, type: Crane, speed: 5, start_location: dock}}
+  - {{name: C2, type: Crane, speed: 5, start_location: dock}}
+jobs:
+  - {{name: lift_the_first_truss_{LONG[:9]}, location: site, plans: [[grip and hold the {LONG}]]}}
+  - {{name: J2, location: site, plans: [[grip and hold the {LONG}, grip and hold the {LONG}]]}}
+distances: {{pairs: [[dock, site, 5]]}}
+precedence: [[lift_the_first_truss_{LONG[:9]}, J2]]
+"""
+
+
+def table_of(problem):
+    from fjsp_planner.cli import format_table
+    from fjsp_planner.solving.solve import solve
+
+    result = solve(problem, time_limit=1)
+    return result, format_table(problem, result).splitlines()
+
+
+def check_columns(problem, result, lines):
+    """Each row's names start where the header's titles do (left-aligned columns), its
+    numbers end where theirs end, and neighbouring cells never touch."""
+    header = lines[0]
+    starts = [header.index(title) for title in ('robot', 'job', 'operation')]
+    ends = [header.index(title) + len(title) for title in ('travel', 'start', 'end')]
+    rows = iter(lines[1:])
+    for robot in problem.robots:
+        for visit in result.schedule.visits(problem, robot.name):
+            line = next(rows)
+            operation = problem.operation_types[
+                result.schedule.jobs[visit.job].robots[robot.name]]
+            for text, start in zip((robot.name, visit.job, operation), starts, strict=True):
+                assert line[start:start + len(text) + 1] == text + ' ', (header, line)
+            travel = (f'{float(visit.travel_start):g}-{float(visit.arrival):g}'
+                      if visit.arrival > visit.travel_start else '-')
+            numbers = (travel, f'{float(visit.start):g}', f'{float(visit.end):g}')
+            for text, end in zip(numbers, ends, strict=True):
+                assert line[end - len(text) - 1:end] == ' ' + text, (header, line)
+            assert len(line) == ends[-1], (header, line)
+        if not result.schedule.sequences[robot.name]:
+            assert next(rows) == f'{robot.name:<{starts[1]}}(no jobs)'
+
+
+def test_table_columns_fit_names_of_any_length():
+    from fjsp_planner.model.scenario import scenario_from_text
+
+    problem = scenario_from_text(LONG_NAMES, name='long')
+    assert max(len(r.name) for r in problem.robots) == 30
+    assert max(len(j.name) for j in problem.jobs) == 30
+    assert max(len(n) for n in problem.operation_types.values()) == 42
+    result, lines = table_of(problem)
+    check_columns(problem, result, lines)
+
+
+@pytest.mark.parametrize('seed', range(8))
+def test_table_columns_line_up_for_generated_scenarios(seed):
+    import yaml
+
+    from fjsp_planner.model.generator import random_scenario
+    from fjsp_planner.model.scenario import scenario_from_text
+
+    problem = scenario_from_text(yaml.safe_dump(random_scenario(seed)), name=f'gen-{seed}')
+    result, lines = table_of(problem)
+    check_columns(problem, result, lines)

@@ -39,7 +39,8 @@ from repo_paths import PAPER
     (['run', 'fjsp_planner', 'fleet', 'truss', '--params-file', '/no/such.yaml'], 2,
      '/no/such.yaml: cannot read parameters file: No such file or directory'),
     (['bag', 'info', 'x.mcap'], 2, 'not provided by this front end'),
-    (['topic', 'echo', '/plan', '--spin-time', '-1'], 2, '--spin-time must be >= 0'),
+    (['topic', 'echo', '/plan', '--spin-time', '-1'], 2,
+     "argument --spin-time: must be a number of seconds >= 0, got '-1'"),
 ])
 def test_bad_input_is_refused_clearly(command, code, message, ros_domain):
     env = dict(os.environ, ROS_DOMAIN_ID=str(ros_domain),

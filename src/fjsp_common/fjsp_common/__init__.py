@@ -15,4 +15,6 @@ With ROS:
 - `running`: how every node declares its parameters and runs;
 - `auth`: the fleet key, signing and checking;
 - `diagnostics`: health on `/diagnostics`.
+- `ros2cli`: the workspace's `ros2` front end (node, param, service, action, topic and
+  interface verbs), a stand-in for ros2cli where it is not installed.
 """

@@ -150,16 +150,29 @@ def status_line(result: Result) -> str:
 
 
 def format_table(problem, result: Result) -> str:
-    lines = [f"{'robot':<12}{'job':<10}{'operation':<24}{'travel':>16}{'start':>9}{'end':>9}"]
+    """One row per robot visit: robot, job, operation, travel leg, start, end; each column
+    as wide as its longest cell, names aligned left, numbers right."""
+    rows = [('robot', 'job', 'operation', 'travel', 'start', 'end')]
+    idle = set()
     for robot in problem.robots:
         for visit in result.schedule.visits(problem, robot.name):
             q = result.schedule.jobs[visit.job].robots[robot.name]
             travel = (f'{_number(visit.travel_start):g}-{_number(visit.arrival):g}'
                       if visit.arrival > visit.travel_start else '-')
-            lines.append(f'{robot.name:<12}{visit.job:<10}{problem.operation_types[q]:<24}'
-                         f'{travel:>16}{_number(visit.start):>9g}{_number(visit.end):>9g}')
+            rows.append((robot.name, visit.job, problem.operation_types[q], travel,
+                         f'{_number(visit.start):g}', f'{_number(visit.end):g}'))
         if not result.schedule.sequences.get(robot.name):
-            lines.append(f'{robot.name:<12}(no jobs)')
+            idle.add(len(rows))
+            rows.append((robot.name, '(no jobs)'))
+    widths = [max(len(row[i]) for row in rows if len(row) > i) for i in range(6)]
+    lines = []
+    for number, row in enumerate(rows):
+        names = [f'{cell:<{width}}' for cell, width in zip(row[:3], widths, strict=False)]
+        if number in idle:
+            lines.append(f'{names[0]}  {row[1]}')
+            continue
+        numbers = [f'{cell:>{width}}' for cell, width in zip(row[3:], widths[3:], strict=True)]
+        lines.append('  '.join(names) + '  ' + '  '.join(numbers))
     return '\n'.join(lines)
 
 

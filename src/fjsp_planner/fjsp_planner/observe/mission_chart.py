@@ -4,7 +4,9 @@ travel, waiting and holds, failed and offline spans, and a line where each revis
 published with the reasons listed under the chart.
 
 It draws `views.timeline` data, the same the web page draws, so the PNG written at the end of
-a mission (or by `replay`) and the live page show one picture.
+a mission (or by `replay`) and the live page show one picture. However long the mission, the
+chart is at most `chart_layout.MAX_WIDTH` wide, and a bar too short for its job's name at that
+scale shows the name shortened, or none.
 """
 
 import json
@@ -18,6 +20,7 @@ from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.patches import Patch  # noqa: E402
 
 from fjsp_planner.observe import views  # noqa: E402
+from fjsp_planner.observe.chart_layout import DPI, BarLabels, Drawn, chart_width, saved  # noqa: E402
 from fjsp_planner.observe.history import FleetHistory, MissionHistory  # noqa: E402
 
 FIRST_PLAN, LAST_PLAN, WORK, ACTIVITY = 0.34, 0.18, -0.04, -0.3
@@ -41,8 +44,8 @@ def job_colours(jobs) -> dict:
     return {job: palette(index % 20) for index, job in enumerate(sorted(set(jobs)))}
 
 
-def draw_mission(timeline: dict, header: dict, path: Path) -> Path:
-    """Write the chart of `timeline` (from `views.timeline`) to `path` (PNG); returns it."""
+def draw_mission(timeline: dict, header: dict, path: Path) -> Drawn:
+    """Write the chart of `timeline` (from `views.timeline`) to `path` (PNG)."""
     robots = timeline['robots']
     rows = {robot: len(robots) - 1 - index for index, robot in enumerate(robots)}
     end = max(timeline['end'] or 1.0, 1.0)
@@ -55,8 +58,9 @@ def draw_mission(timeline: dict, header: dict, path: Path) -> Path:
     # Heights in inches: title, one per robot, axis and legend, a line per revision's reasons.
     below = 1.1 + 0.17 * len(notes)
     height = 0.65 + 0.95 * len(robots) + below
-    width = min(28.0, max(11.0, 0.1 * end + 7))
-    fig, ax = plt.subplots(figsize=(width, height))
+    width = chart_width(end, 0.1, 7.0, 11.0)
+    fig, ax = plt.subplots(figsize=(width, height), dpi=DPI)
+    labels = BarLabels(ax)
     label = 0.2 + 0.075 * max((len(r) for r in robots), default=4)
     fig.subplots_adjust(left=label / width, right=0.99, top=1 - 0.55 / height,
                         bottom=below / height)
@@ -96,9 +100,8 @@ def draw_mission(timeline: dict, header: dict, path: Path) -> Path:
         style = OUTCOME_STYLE.get(w['outcome'], OUTCOME_STYLE['done'])
         ax.barh(y, max(stop - w['start'], 0.05), left=w['start'], height=0.3,
                 color=colour[w['job']], **style)
-        label = w['job'] + (f"#{w['attempt']}" if w['attempt'] > 1 else '')
-        ax.text((w['start'] + stop) / 2, y, label, ha='center', va='center', fontsize=6.5,
-                color='black' if w['outcome'] != 'voided' else 'dimgrey')
+        labels.add(w['job'] + (f"#{w['attempt']}" if w['attempt'] > 1 else ''), w['start'],
+                   stop, y, color='black' if w['outcome'] != 'voided' else 'dimgrey')
     for a in timeline['activities']:
         style = ACTIVITY_STYLE.get(a['mode'])
         if style and a['robot'] in rows:
@@ -129,9 +132,7 @@ def draw_mission(timeline: dict, header: dict, path: Path) -> Path:
         fig.text(0.01, 0.06 / height, '\n'.join(notes), fontsize=7.5, va='bottom')
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return saved(fig, path, labels.write())
 
 
 def write_mission(fleet: FleetHistory, mission: MissionHistory, wall: float, png: Path) -> None:

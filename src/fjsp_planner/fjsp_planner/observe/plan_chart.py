@@ -1,5 +1,8 @@
 """The paper's schedule chart (Figs. 5-6): a row per robot, a coloured bar per job, black
-lines for travel, the makespan marked. An executed timeline can be drawn under the plan."""
+lines for travel, the makespan marked. An executed timeline can be drawn under the plan.
+
+However long the schedule, the chart is at most `chart_layout.MAX_WIDTH` wide; a bar too
+short for its job's name at that scale shows the name shortened, or none (`chart_layout`)."""
 
 import matplotlib
 
@@ -8,10 +11,15 @@ import matplotlib.pyplot as plt  # noqa: E402  (the backend must be chosen first
 
 from fjsp_planner.model.problem import Problem  # noqa: E402
 from fjsp_planner.model.schedule import Schedule  # noqa: E402
+from fjsp_planner.observe.chart_layout import DPI, BarLabels, Drawn, chart_width, saved  # noqa: E402
+
+ROW_HEIGHT = 0.8
+"""Inches per robot."""
 
 
 def draw_gantt(problem: Problem, schedule: Schedule, path, title: str = '',
-               executed: Schedule | None = None) -> None:
+               executed: Schedule | None = None) -> Drawn:
+    """Write the chart of `schedule` (and `executed` under it) to `path` (PNG)."""
     robots = [r.name for r in problem.robots]
     names = sorted(schedule.jobs)
     palette = plt.get_cmap('tab20')
@@ -19,8 +27,10 @@ def draw_gantt(problem: Problem, schedule: Schedule, path, title: str = '',
     rows = [(schedule, 0.0, 0.6 if executed is None else 0.38, 'planned')]
     if executed is not None:
         rows.append((executed, -0.4, 0.3, 'executed'))
-    fig, ax = plt.subplots(figsize=(max(8.0, 0.16 * float(schedule.makespan) + 4),
-                                    1.0 + 0.8 * len(robots)))
+    span = max([float(schedule.makespan)] + ([float(executed.makespan)] if executed else []))
+    fig, ax = plt.subplots(figsize=(chart_width(span, 0.16, 4.0, 8.0),
+                                    1.0 + ROW_HEIGHT * len(robots)), dpi=DPI)
+    labels = BarLabels(ax)
     for timeline, offset, height, _ in rows:
         for y, robot in enumerate(robots):
             centre = len(robots) - 1 - y + offset
@@ -32,8 +42,7 @@ def draw_gantt(problem: Problem, schedule: Schedule, path, title: str = '',
                 ax.barh(centre, float(a.end - a.start), left=float(a.start), height=height,
                         color=colour.get(visit.job, 'grey'), edgecolor='black',
                         hatch='//' if timeline is executed else None)
-                ax.text(float(a.start + a.end) / 2, centre, visit.job, ha='center',
-                        va='center', fontsize=7)
+                labels.add(visit.job, float(a.start), float(a.end), centre)
     for timeline, _, _, label in rows:
         style = '--' if label == 'planned' else ':'
         ax.axvline(float(timeline.makespan), color='red', linestyle=style)
@@ -44,8 +53,7 @@ def draw_gantt(problem: Problem, schedule: Schedule, path, title: str = '',
     ax.set_xlim(left=0)
     ax.set_title(title or problem.name)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    return saved(fig, path, labels.write())
 
 
 def _visits(problem, schedule, robot):
