@@ -56,7 +56,7 @@ def test_the_paper_chart_names_every_job(tmp_path):
     assert png_size(tmp_path / 'paper.png') == (drawn.width, drawn.height)
 
 
-@pytest.mark.parametrize('jobs', [60, 300])
+@pytest.mark.parametrize('jobs', [60, pytest.param(300, marks=pytest.mark.slow)])
 def test_plan_charts_of_large_scenarios_stay_readable(tmp_path, jobs):
     problem, schedule = generated(jobs)
     drawn = draw_gantt(problem, schedule, tmp_path / 'plan.png')
@@ -88,7 +88,7 @@ def mission_timeline(problem, schedule) -> dict:
             'work': work, 'activities': [], 'health': []}
 
 
-@pytest.mark.parametrize('jobs', [60, 300])
+@pytest.mark.parametrize('jobs', [60, pytest.param(300, marks=pytest.mark.slow)])
 def test_mission_charts_of_large_missions_stay_readable(tmp_path, jobs):
     problem, schedule = generated(jobs)
     header = {'scenario': problem.name, 'mission_id': 'm-1', 'state': 'complete',
