@@ -189,7 +189,7 @@ def test_only_a_reported_overrun_beyond_the_threshold_is_late(planned):
     assert tracker.overruns(2.0) == []
     tracker.record_robot_state(robot, 'working', name, '', end + 2.5, name)
     [late] = tracker.overruns(2.0)
-    assert f"job '{name}'" in late and '2.50 after its plan' in late
+    assert f"job '{name}'" in late and '2.500 after its plan' in late
 
 
 def test_failure_replan_and_completion_give_a_valid_executed_timeline(planned):
@@ -484,7 +484,7 @@ def test_a_valid_execution_has_no_violations():
      "holding arc ('J', 'W', 0): type-0 robots of 'J' are ['A'] but of 'W' are ['B']"),
     (sched({'A': ('X', 'J'), 'B': ()}, X=(0, 3, {'A': 1}), J=(3.5, 5.5, {'A': 0})),
      [('X', 0, {'A': 3}), ('J', 3.5, {'A': 5.5})],
-     "robot 'A': job 'J' starts at 7/2 but the robot ends 'X' at 3 and travels 2 from 'c' "
+     "robot 'A': job 'J' starts at 3.500 but the robot ends 'X' at 3 and travels 2 from 'c' "
      "to 'a', arriving at 5"),
     (sched({'A': ('W',), 'B': ('W',)}, W=(0, 3, {'A': 0, 'B': 0})),
      [('W', 0, {'A': 2, 'B': 2})],

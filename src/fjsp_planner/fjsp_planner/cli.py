@@ -17,6 +17,7 @@ import threading
 from fractions import Fraction
 from pathlib import Path
 
+from fjsp_planner.model.decimals import decimal, decimals
 from fjsp_planner.model.limits import MAX_WORKERS
 from fjsp_planner.model.problem import ProblemError
 from fjsp_planner.model.schedule import Result
@@ -117,7 +118,7 @@ def _plan(args) -> int:
             from fjsp_planner.observe.plan_chart import draw_gantt
 
             draw_gantt(problem, result.schedule, args.gantt,
-                       title=f'{problem.name}: makespan {_number(result.makespan):g}')
+                       title=f'{problem.name}: makespan {decimal(result.makespan)}')
     except OSError as error:
         print(f'fjsp-solve: cannot write {error.filename}: {error.strerror}', file=sys.stderr)
         return EXIT_BAD_INPUT
@@ -139,10 +140,11 @@ def _load(args):
 
 def status_line(result: Result) -> str:
     parts = [f'status {result.status.value}', f'solver {result.solver}']
+    makespan, bound = decimals(result.makespan, result.lower_bound)
     if result.makespan is not None:
-        parts.append(f'makespan {_number(result.makespan):g}')
+        parts.append(f'makespan {makespan}')
     if result.lower_bound is not None:
-        parts.append(f'bound {_number(result.lower_bound):g}')
+        parts.append(f'bound {bound}')
     if result.gap is not None:
         parts.append(f'gap {100 * result.gap:.1f}%')
     parts.append(f'time {result.solve_seconds:.2f} s')
@@ -157,10 +159,11 @@ def format_table(problem, result: Result) -> str:
     for robot in problem.robots:
         for visit in result.schedule.visits(problem, robot.name):
             q = result.schedule.jobs[visit.job].robots[robot.name]
-            travel = (f'{_number(visit.travel_start):g}-{_number(visit.arrival):g}'
-                      if visit.arrival > visit.travel_start else '-')
-            rows.append((robot.name, visit.job, problem.operation_types[q], travel,
-                         f'{_number(visit.start):g}', f'{_number(visit.end):g}'))
+            left, arrival, start, end = decimals(visit.travel_start, visit.arrival,
+                                                 visit.start, visit.end)
+            travel = f'{left}-{arrival}' if visit.arrival > visit.travel_start else '-'
+            rows.append((robot.name, visit.job, problem.operation_types[q], travel, start,
+                         end))
         if not result.schedule.sequences.get(robot.name):
             idle.add(len(rows))
             rows.append((robot.name, '(no jobs)'))

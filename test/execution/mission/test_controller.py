@@ -4,6 +4,7 @@ The paper's instance: its optimum (32) is found in well under a second, so every
 controller asks for is run here for real, through the same functions the node calls.
 """
 
+import re
 from dataclasses import replace
 from fractions import Fraction
 
@@ -374,7 +375,7 @@ def test_executed_mission_completes(problem):
     assert len(kinds(fleet.effects, JobDone)) == 12
     assert fleet.state() == MissionState.COMPLETE
     (complete,) = notes(fleet.effects, MissionEventKind.MISSION_COMPLETE)
-    assert 'executed makespan 32.00' in complete.reasons[0]
+    assert complete.reasons == ('executed makespan 32, planned 32',)
 
 
 def test_an_invalid_executed_timeline_fails_the_mission(problem):
@@ -387,6 +388,21 @@ def test_an_invalid_executed_timeline_fails_the_mission(problem):
             fleet.event(EventKind.OPERATION_DONE, robot, name, 1.0)
     assert fleet.state() == MissionState.FAILED
     assert any('executed timeline' in r for r in fleet.status().blocked)
+
+
+def test_the_failure_reason_writes_times_as_decimals(problem):
+    """Agents report float times, exact as Fractions such as 0.1 =
+    3602879701896397/36028797018963968: the reason a person reads has decimals."""
+    fleet = executing(problem)
+    plan = fleet.controller.mission.schedule
+    for name, a in plan.jobs.items():
+        for robot in a.robots:
+            fleet.event(EventKind.STARTED, robot, name, 0.1)
+            fleet.event(EventKind.OPERATION_DONE, robot, name, 1.1)
+    reasons = fleet.status().blocked
+    assert fleet.state() == MissionState.FAILED and reasons
+    assert not [r for r in reasons if re.search(r'\d/\d', r)], reasons
+    assert any('starts at 0.100' in r and 'completes at 1.100' in r for r in reasons), reasons
 
 
 def test_events_of_another_mission_are_counted_once_logged(problem):

@@ -29,6 +29,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from fractions import Fraction
 
+from fjsp_planner.model.decimals import decimal
 from fjsp_planner.model.problem import FixedJob, Job, Problem, Robot, max_staffed
 from fjsp_planner.model.schedule import JobAssignment, Result, Schedule, Status
 from fjsp_planner.model.validate import validate
@@ -532,7 +533,7 @@ def _pose(problem, state, healthy, todo, fixed, kept, began, carried_to, aborted
         locomote=problem.locomote,
         time_overrides={k: v for k, v in problem.time_overrides.items() if k[0] in healthy},
         fixed=pinned,
-        name=f'{problem.name}@{now}',
+        name=f'{problem.name}@{decimal(now)}',
     )
 
 
@@ -561,7 +562,7 @@ def _raise_on_state_problems(problem: Problem, state: ExecutionState) -> None:
     locations = set(problem.locations())
     problems = []
     if state.now < 0:
-        problems.append(f'now is negative ({state.now})')
+        problems.append(f'now is negative ({decimal(state.now)})')
     for name in sorted(set(state.done) - jobs):
         problems.append(f"done job '{name}' is not a job")
     for name in sorted(set(state.done) & set(state.running)):

@@ -23,6 +23,7 @@ from fractions import Fraction
 from fjsp_common.revisions import void
 from fjsp_common.vocabulary import EventKind, RobotMode
 from fjsp_planner.execution.replan import ExecutionState, RobotSituation
+from fjsp_planner.model.decimals import decimal, decimals
 from fjsp_planner.model.limits import shown
 from fjsp_planner.model.problem import Problem
 from fjsp_planner.model.schedule import JobAssignment, Schedule
@@ -262,8 +263,9 @@ class MissionTracker:
                                             'reported started')
         if time < started:
             return Verdict(Ignored.UNKNOWN, f"{what}: '{robot}' reports "
-                                            f'operation_done at t={float(time):g} before it '
-                                            f"started at t={float(started):g} (job '{job}')")
+                                            'operation_done at t={} before it started at '
+                                            "t={} (job '{}')".format(*decimals(time, started),
+                                                                     job))
         return None
 
     def record_robot_state(self, robot: str, mode: str, location: str, destination: str,
@@ -448,8 +450,8 @@ class MissionTracker:
                           Fraction(record.start) + self._planned_length(name))
             expected = self._reported_end(name)
             if expected - planned > threshold:
-                late.append(f"job '{name}' is expected to end at {float(expected):.2f}, "
-                            f'{float(expected - planned):.2f} after its plan')
+                late.append(f"job '{name}' is expected to end at {decimal(expected)}, "
+                            f'{decimal(expected - planned)} after its plan')
         return late
 
     def executed_schedule(self) -> Schedule:

@@ -21,6 +21,7 @@ from fjsp_planner.launcher.supervision import (
     Fleet,
     FleetError,
 )
+from fjsp_planner.model.decimals import decimals
 from fjsp_planner.workspace import default_out_dir
 
 
@@ -172,8 +173,8 @@ def _ended(status: MissionStatus) -> int | None:
     mission = status.mission_id or status.scenario_id
     if status.state == MissionStatus.STATE_COMPLETE:
         print(f"fleet: mission '{mission}' complete: {status.jobs_done}/{status.jobs_total} "
-              f'jobs done, makespan {status.projected_makespan:.2f} (planned '
-              f'{status.planned_makespan:.2f}) schedule units', flush=True)
+              'jobs done, makespan {} (planned {}) schedule units'.format(
+                  *decimals(status.projected_makespan, status.planned_makespan)), flush=True)
         return 0
     if status.state in (MissionStatus.STATE_FAILED, MissionStatus.STATE_CANCELLED):
         word = 'failed' if status.state == MissionStatus.STATE_FAILED else 'was cancelled'

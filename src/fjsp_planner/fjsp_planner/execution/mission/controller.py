@@ -40,6 +40,7 @@ from fjsp_planner.execution.mission.settings import Settings
 from fjsp_planner.execution.mission.states import INITIAL, check_transition
 from fjsp_planner.execution.replan import ExecutionState, Replan, RobotSituation, residual_problem
 from fjsp_planner.execution.tracking import Ignored, MissionTracker
+from fjsp_planner.model.decimals import decimal, decimals
 from fjsp_planner.model.problem import Problem
 from fjsp_planner.model.schedule import Result, Schedule, Status
 from fjsp_planner.model.validate import validate
@@ -614,12 +615,12 @@ class MissionController:
                                                    progressed, continued):
             # The robots got further than the search kept: the plan cannot be followed.
             dropped = Note(MissionEventKind.WARNING, (
-                f'a better plan (makespan {float(better.result.makespan):.2f}) dropped: '
+                f'a better plan (makespan {decimal(better.result.makespan)}) dropped: '
                 + ', '.join(f"job '{j}'" for j in progressed)
                 + ' progressed while it was searched for',))
             return [dropped] + self._search_longer(mission, solving, solving.published, wall)
-        reason = (f'a better plan: makespan {mission.planned_makespan:.2f} -> '
-                  f'{float(better.result.makespan):.2f}')
+        reason = 'a better plan: makespan {} -> {}'.format(
+            *decimals(mission.planned_makespan, better.result.makespan))
         continued |= frozenset(progressed)
         continued |= continuation.unchanged(mission.tracker, better.schedule, continued)
         published = self._publish(mission, better.residual.problem, better.result, continued,
@@ -721,10 +722,10 @@ class MissionController:
         mission.enter(MissionState.COMPLETE)
         # A mission blocked for want of robots can still complete on the plan it had.
         mission.blocked, mission.blocked_since = (), None
-        executed = float(mission.tracker.projected_makespan(0))
+        executed = mission.tracker.projected_makespan(0)
         return [Note(MissionEventKind.MISSION_COMPLETE,
-                     (f'executed makespan {executed:.2f}, planned '
-                      f'{mission.planned_makespan:.2f}',))]
+                     ('executed makespan {}, planned {}'.format(
+                         *decimals(executed, mission.planned_makespan)),))]
 
     # --- views -----------------------------------------------------------------------------
 
