@@ -30,7 +30,15 @@ from dataclasses import dataclass, field, replace
 from fractions import Fraction
 
 from fjsp_planner.model.decimals import decimal
-from fjsp_planner.model.problem import FixedJob, Job, Problem, Robot, max_staffed
+from fjsp_planner.model.problem import (
+    FixedJob,
+    Job,
+    Problem,
+    Robot,
+    how_many_can,
+    max_staffed,
+    robots_needed,
+)
 from fjsp_planner.model.schedule import JobAssignment, Result, Schedule, Status
 from fjsp_planner.model.validate import validate
 from fjsp_planner.solving.bounds.panel import critical_path_bound
@@ -465,10 +473,9 @@ def _staffing_problems(problem, todo, healthy, kept, failed) -> list[str]:
             staffed = max_staffed(problem, rest_plan, others)
             if staffed < len(rest_plan):
                 held = f' besides the holders {_named(holders)}' if holders else ''
-                shortfalls.append(f'plan {index} {problem.plan_label(plan)} needs '
-                                  f'{len(rest_plan)} distinct robots able to do '
-                                  f'{problem.plan_label(rest_plan)}{held}; {staffed} healthy '
-                                  'can')
+                needed = robots_needed(len(rest_plan), problem.plan_label(rest_plan))
+                shortfalls.append(f'plan {index} {problem.plan_label(plan)} needs {needed}'
+                                  f"{held}; {how_many_can(staffed, 'healthy')}")
         if len(shortfalls) == len(job.plans):
             problems.append(f"job '{job.name}' cannot be staffed: " + '; '.join(shortfalls)
                             + why_short)
