@@ -22,6 +22,7 @@ from fjsp_planner.launcher.supervision import (
     FleetError,
 )
 from fjsp_planner.model.decimals import decimals
+from fjsp_planner.model.scenario import scenario_warnings
 from fjsp_planner.workspace import default_out_dir
 
 
@@ -110,6 +111,8 @@ def run(args: argparse.Namespace) -> int:
     """The mission's exit code, once it has ended."""
     previous = {sig: signal.signal(sig, _stop_signal) for sig in (signal.SIGINT, signal.SIGTERM)}
     try:
+        for warning in scenario_warnings(fleet.problem):
+            print(f'fleet: warning: {warning}', file=sys.stderr, flush=True)
         fleet.start(stream_monitor=True, recorder=not args.no_recording)
         robots = ', '.join(r.name for r in fleet.problem.robots)
         print(f"fleet: scenario '{fleet.problem.name}' ({fleet.scenario}): planner, agents "

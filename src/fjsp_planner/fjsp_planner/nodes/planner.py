@@ -82,7 +82,7 @@ from fjsp_planner.execution.tracking import Ignored
 from fjsp_planner.model.decimals import decimal, decimals
 from fjsp_planner.model.extension import extend
 from fjsp_planner.model.problem import ProblemError
-from fjsp_planner.model.scenario import load_scenario, scenario_from_text
+from fjsp_planner.model.scenario import load_scenario, scenario_from_text, scenario_warnings
 from fjsp_planner.nodes.conversions import cancel_msg, job_states, plan_msg
 from fjsp_planner.solving.solve import solve
 
@@ -257,6 +257,8 @@ class PlannerNode(Node):
             self.journal.write(MissionRecord(
                 mission_id, text, name, panels, shift, origin, settings.__dict__, self.wall()))
         self.get_logger().info(f"mission '{mission_id}' accepted")
+        for warning in scenario_warnings(problem):
+            self.get_logger().warning(f'scenario {problem.name!r}: {warning}')
         self.carry_out(effects)
         return mission_id
 
