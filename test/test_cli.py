@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from fjsp_planner.model.decimals import decimals
+from fjsp_common.decimals import decimals
 
 from repo_paths import FRAGMENTS, PAPER, REPO
 

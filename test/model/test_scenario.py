@@ -155,7 +155,7 @@ INVALID = [
     ('fraction dividing by zero', ('robots', 0, 'speed'), '1/0',
      "robot 'Assembler' speed: '1/0' divides by zero"),
     ('derived travel too long', ('robot_types', 'Assembler', 'locomote'), 10**6,
-     "robot 'Assembler': travelling from 'Ab' to 'Md' would take 1.93333e+06 units "
+     "robot 'Assembler': travelling from 'Ab' to 'Md' would take 1933333.333 units "
      '(distance 58 x locomote efficiency 1e+06 / speed 30), more than the limit of 1e+06'),
     # Names and sizes a file can make enormous cheaply.
     ('name that is a list', ('jobs', 0, 'name'), ['M', 1],
@@ -298,7 +298,7 @@ def test_panels_that_make_travel_too_long(tmp_path):
     with pytest.raises(ScenarioError) as caught:
         load_scenario(PAPER, panels=50, shift=30000)
     assert any("robot 'Assembler': travelling from 'Ab' of panel 1 to 'Md' of panel 50 would "
-               'take 4.90019e+06 units (distance 1.47006e+06 x locomote efficiency 100 / '
+               'take 4900193.333 units (distance 1.47006e+06 x locomote efficiency 100 / '
                'speed 30), more than the limit of 1e+06' in p
                for p in caught.value.problems), caught.value.problems
 

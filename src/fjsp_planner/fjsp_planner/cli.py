@@ -17,7 +17,7 @@ import threading
 from fractions import Fraction
 from pathlib import Path
 
-from fjsp_planner.model.decimals import decimal, decimals
+from fjsp_common.decimals import decimal, decimals
 from fjsp_planner.model.limits import MAX_WORKERS
 from fjsp_planner.model.problem import ProblemError, listed
 from fjsp_planner.model.schedule import Result

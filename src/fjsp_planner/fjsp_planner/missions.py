@@ -29,7 +29,7 @@ import uuid
 from dataclasses import dataclass
 from pathlib import Path
 
-from fjsp_planner.model.decimals import decimal, decimals
+from fjsp_common.decimals import decimal, decimals
 
 RESEND = 1.0
 """Seconds without an answer after which a request is sent again."""

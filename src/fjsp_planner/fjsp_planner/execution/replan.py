@@ -29,7 +29,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from fractions import Fraction
 
-from fjsp_planner.model.decimals import decimal
+from fjsp_common.decimals import decimal
 from fjsp_planner.model.problem import (
     FixedJob,
     Job,

@@ -20,10 +20,10 @@ from dataclasses import dataclass, field
 from enum import StrEnum
 from fractions import Fraction
 
+from fjsp_common.decimals import decimal, decimals
 from fjsp_common.revisions import void
 from fjsp_common.vocabulary import EventKind, RobotMode
 from fjsp_planner.execution.replan import ExecutionState, RobotSituation
-from fjsp_planner.model.decimals import decimal, decimals
 from fjsp_planner.model.limits import shown
 from fjsp_planner.model.problem import Problem
 from fjsp_planner.model.schedule import JobAssignment, Schedule

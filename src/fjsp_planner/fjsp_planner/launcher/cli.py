@@ -10,6 +10,7 @@ from pathlib import Path
 
 from fjsp_common.auth import KEY_FILE_VARIABLE
 from fjsp_common.contract import LATCHED_QOS, MISSION_STATUS_TOPIC
+from fjsp_common.decimals import decimals
 from fjsp_msgs.msg import MissionStatus
 from fjsp_planner.launcher.listener import Listener
 from fjsp_planner.launcher.supervision import (
@@ -21,7 +22,6 @@ from fjsp_planner.launcher.supervision import (
     Fleet,
     FleetError,
 )
-from fjsp_planner.model.decimals import decimals
 from fjsp_planner.model.scenario import scenario_warnings
 from fjsp_planner.workspace import default_out_dir
 

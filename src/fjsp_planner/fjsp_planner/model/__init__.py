@@ -6,7 +6,7 @@
 - `extension`: jobs added to a running mission, as a scenario fragment;
 - `limits`: how large and how extreme an input may be, checked before anything is built;
 - `schedule`: `Schedule` (exact times) and the solver-neutral `Result`;
-- `decimals`: how times are written for people (decimals, never raw fractions);
 - `validate`: the independent check every schedule goes through; it shares no code with the
-  solvers. Its messages (`Violation`) read in decimals and keep the exact times.
+  solvers. Its messages (`Violation`) read in decimals (`fjsp_common.decimals`) and keep
+  the exact times.
 """

@@ -10,7 +10,7 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from fractions import Fraction
 
-from fjsp_planner.model.decimals import decimal, decimals
+from fjsp_common.decimals import decimal, decimals
 
 
 class ProblemError(ValueError):

@@ -13,8 +13,8 @@ from pathlib import Path
 
 import yaml
 
+from fjsp_common.decimals import decimals
 from fjsp_planner.model import limits
-from fjsp_planner.model.decimals import decimals
 from fjsp_planner.model.limits import MAX_TIME, shown
 from fjsp_planner.model.problem import Job, Problem, ProblemError, Robot, listed, suggestion
 

@@ -8,14 +8,14 @@ travel is recomputed from `Problem.travel` rather than read from `Schedule.visit
 from collections import Counter
 from fractions import Fraction
 
-from fjsp_planner.model.decimals import decimals
+from fjsp_common.decimals import decimals
 from fjsp_planner.model.problem import Problem, Robot
 from fjsp_planner.model.schedule import JobAssignment, Schedule
 
 
 class Violation(str):
     """One way a schedule breaks its problem, as a person reads it: its times written as
-    decimals (`fjsp_planner.model.decimals`). `exact` says the same with exact fractions,
+    decimals (`fjsp_common.decimals`). `exact` says the same with exact fractions,
     and `values` holds what it names, times as exact `Fraction`s."""
 
     exact: str

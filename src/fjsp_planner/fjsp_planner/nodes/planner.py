@@ -49,6 +49,7 @@ from fjsp_common.contract import (
     publisher,
     subscription,
 )
+from fjsp_common.decimals import decimal, decimals
 from fjsp_common.diagnostics import diagnostic_array, planner_diagnostic
 from fjsp_common.fleet import DIAGNOSTICS_PERIOD, PLANNER_NODE
 from fjsp_common.running import ParameterError, declare, run_node, shorten
@@ -79,7 +80,6 @@ from fjsp_planner.execution.mission.reports import EventReport, RobotReport
 from fjsp_planner.execution.mission.settings import PARAMETERS, SETTINGS_PARAMETERS, Settings
 from fjsp_planner.execution.replan import improve, repair
 from fjsp_planner.execution.tracking import Ignored
-from fjsp_planner.model.decimals import decimal, decimals
 from fjsp_planner.model.extension import extend
 from fjsp_planner.model.problem import ProblemError
 from fjsp_planner.model.scenario import load_scenario, scenario_from_text, scenario_warnings

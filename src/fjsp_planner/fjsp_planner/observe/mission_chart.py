@@ -19,7 +19,7 @@ import matplotlib.pyplot as plt  # noqa: E402  (the backend must be chosen first
 from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.patches import Patch  # noqa: E402
 
-from fjsp_planner.model.decimals import decimal, decimals  # noqa: E402
+from fjsp_common.decimals import decimal, decimals  # noqa: E402
 from fjsp_planner.observe import views  # noqa: E402
 from fjsp_planner.observe.chart_layout import DPI, BarLabels, Drawn, chart_width, saved  # noqa: E402
 from fjsp_planner.observe.history import FleetHistory, MissionHistory  # noqa: E402

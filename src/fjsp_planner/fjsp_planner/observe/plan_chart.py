@@ -9,7 +9,7 @@ import matplotlib
 matplotlib.use('Agg')
 import matplotlib.pyplot as plt  # noqa: E402  (the backend must be chosen first)
 
-from fjsp_planner.model.decimals import decimal  # noqa: E402
+from fjsp_common.decimals import decimal  # noqa: E402
 from fjsp_planner.model.problem import Problem  # noqa: E402
 from fjsp_planner.model.schedule import Schedule  # noqa: E402
 from fjsp_planner.observe.chart_layout import DPI, BarLabels, Drawn, chart_width, saved  # noqa: E402

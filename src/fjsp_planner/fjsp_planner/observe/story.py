@@ -12,8 +12,8 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 
 from fjsp_common.clock import ScheduleClock
+from fjsp_common.decimals import decimal
 from fjsp_common.vocabulary import MissionEventKind, MissionState
-from fjsp_planner.model.decimals import decimal
 from fjsp_planner.observe.history import Counts, MissionHistory, Outcome
 
 

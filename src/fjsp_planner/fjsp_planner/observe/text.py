@@ -2,7 +2,7 @@
 notice changed, one line per event of the story, and the summary of an ended mission, so that
 a scroll-back of the monitor's output tells what happened and why."""
 
-from fjsp_planner.model.decimals import decimal, decimals
+from fjsp_common.decimals import decimal, decimals
 from fjsp_planner.observe.history import MissionHistory
 
 

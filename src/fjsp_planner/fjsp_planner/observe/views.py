@@ -8,9 +8,9 @@ Times in them are schedule units.
 
 import math
 
+from fjsp_common.decimals import decimal
 from fjsp_common.revisions import void
 from fjsp_common.vocabulary import EventKind, MissionState, RobotMode
-from fjsp_planner.model.decimals import decimal
 from fjsp_planner.observe.history import FleetHistory, MissionHistory, Outcome
 from fjsp_planner.observe.story import story as told
 

@@ -5,7 +5,7 @@ import threading
 import time
 from fractions import Fraction
 
-from fjsp_planner.model.decimals import decimal
+from fjsp_common.decimals import decimal
 from fjsp_planner.model.limits import MAX_WORKERS
 from fjsp_planner.model.problem import Problem
 from fjsp_planner.model.schedule import Result, Schedule, Status

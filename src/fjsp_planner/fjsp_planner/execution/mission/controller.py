@@ -21,6 +21,7 @@ from dataclasses import dataclass, field, replace
 from fractions import Fraction
 
 from fjsp_common.clock import ScheduleClock
+from fjsp_common.decimals import decimal, decimals
 from fjsp_common.vocabulary import EventKind, MissionEventKind, MissionState, RobotMode
 from fjsp_planner.execution.journal import Record
 from fjsp_planner.execution.mission import continuation
@@ -40,7 +41,6 @@ from fjsp_planner.execution.mission.settings import Settings
 from fjsp_planner.execution.mission.states import INITIAL, check_transition
 from fjsp_planner.execution.replan import ExecutionState, Replan, RobotSituation, residual_problem
 from fjsp_planner.execution.tracking import Ignored, MissionTracker
-from fjsp_planner.model.decimals import decimal, decimals
 from fjsp_planner.model.problem import Problem
 from fjsp_planner.model.schedule import Result, Schedule, Status
 from fjsp_planner.model.validate import validate

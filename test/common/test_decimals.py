@@ -5,7 +5,7 @@ from fractions import Fraction
 
 import pytest
 
-from fjsp_planner.model.decimals import decimal, decimals
+from fjsp_common.decimals import decimal, decimals
 
 
 @pytest.mark.parametrize(('times', 'written'), [
