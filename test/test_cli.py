@@ -13,11 +13,12 @@ import pytest
 
 from fjsp_common.decimals import decimals
 
-from repo_paths import FRAGMENTS, PAPER, REPO
+from repo_paths import DATA, FRAGMENTS, PAPER, REPO
 
 
 def fjsp_solve(*args, cwd=None):
-    env = dict(os.environ, PYTHONPATH=str(REPO / 'src' / 'fjsp_planner'))
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(
+        str(REPO / 'src' / package) for package in ('fjsp_planner', 'fjsp_common')))
     return subprocess.run([sys.executable, '-m', 'fjsp_planner.cli', *map(str, args)],
                           capture_output=True, text=True, env=env, cwd=cwd, timeout=120)
 
@@ -177,7 +178,8 @@ def _signal_a_thread_other_than_the_main_one(pid, signum):
 def test_signals_stop_it_at_once_with_one_line(signum, panels, ready, stage, to_thread):
     """The kernel hands a signal sent to the process to any thread not blocking it, mostly
     the main one; when it chose another, fjsp-solve went on for its whole time limit."""
-    env = dict(os.environ, PYTHONPATH=str(REPO / 'src' / 'fjsp_planner'))
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(
+        str(REPO / 'src' / package) for package in ('fjsp_planner', 'fjsp_common')))
     process = subprocess.Popen(
         [sys.executable, '-m', 'fjsp_planner.cli', PAPER, '--panels', str(panels),
          '--time-limit', '120'], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
@@ -278,20 +280,7 @@ def test_table_columns_line_up_for_generated_scenarios(seed):
 
 # --- checking a file without solving -----------------------------------------------------
 
-BEAM = """
-operation_types: {0: grip, 1: weld, 2: drive}
-robot_types:
-  Crane: {grip: 2, drive: 10}
-  Welder: {grip: 4, weld: 3, drive: 2}
-robots:
-  - {name: C1, type: Crane, speed: 5, start_location: dock}
-  - {name: W1, type: Welder, speed: 10, start_location: dock, release_time: 1}
-jobs:
-  - {name: Lift, location: site, plans: [[grip]]}
-  - {name: Join, location: site, plans: [[grip, weld]]}
-distances: {pairs: [[dock, site, 5]]}
-precedence: [[Lift, Join]]
-"""
+BEAM = (DATA / 'beam_drive.yaml').read_text()
 
 FRAGMENT = FRAGMENTS / 'solar_panel_second_panel.yaml'
 

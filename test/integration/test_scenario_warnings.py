@@ -4,30 +4,14 @@ warning before it starts anything, the planner logs it, and the mission runs."""
 import os
 import subprocess
 
-SCENARIO = """
-name: beam
-operation_types: {0: grip, 1: weld, 2: drive}
-robot_types:
-  Crane: {grip: 2, drive: 10}
-  Welder: {grip: 4, weld: 3, drive: 2}
-robots:
-  - {name: C1, type: Crane, speed: 5, start_location: dock}
-  - {name: W1, type: Welder, speed: 10, start_location: dock, release_time: 1}
-jobs:
-  - {name: Lift, location: site, plans: [[grip]]}
-  - {name: Join, location: site, plans: [[grip, weld]]}
-distances: {pairs: [[dock, site, 5]]}
-precedence: [[Lift, Join]]
-holding: [[Lift, Join, grip]]
-"""
+from repo_paths import DATA
 
 WARNING = ("distances and the start locations of robots 'C1', 'W1' are given, but no "
            'operation type is the travel type')
 
 
 def test_the_launcher_and_the_planner_warn_and_the_mission_runs(tmp_path, ros_domain):
-    scenario = tmp_path / 'beam.yaml'
-    scenario.write_text(SCENARIO)
+    scenario = DATA / 'beam_drive.yaml'
     out = tmp_path / 'out'
     env = dict(os.environ, ROS_DOMAIN_ID=str(ros_domain), PYTHONUNBUFFERED='1',
                ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
