@@ -11,11 +11,14 @@ from pathlib import Path
 
 import pytest
 
-from repo_paths import PAPER, REPO
+from fjsp_common.decimals import decimals
+
+from repo_paths import DATA, FRAGMENTS, PAPER, REPO
 
 
 def fjsp_solve(*args, cwd=None):
-    env = dict(os.environ, PYTHONPATH=str(REPO / 'src' / 'fjsp_planner'))
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(
+        str(REPO / 'src' / package) for package in ('fjsp_planner', 'fjsp_common')))
     return subprocess.run([sys.executable, '-m', 'fjsp_planner.cli', *map(str, args)],
                           capture_output=True, text=True, env=env, cwd=cwd, timeout=120)
 
@@ -175,7 +178,8 @@ def _signal_a_thread_other_than_the_main_one(pid, signum):
 def test_signals_stop_it_at_once_with_one_line(signum, panels, ready, stage, to_thread):
     """The kernel hands a signal sent to the process to any thread not blocking it, mostly
     the main one; when it chose another, fjsp-solve went on for its whole time limit."""
-    env = dict(os.environ, PYTHONPATH=str(REPO / 'src' / 'fjsp_planner'))
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(
+        str(REPO / 'src' / package) for package in ('fjsp_planner', 'fjsp_common')))
     process = subprocess.Popen(
         [sys.executable, '-m', 'fjsp_planner.cli', PAPER, '--panels', str(panels),
          '--time-limit', '120'], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
@@ -240,9 +244,10 @@ def check_columns(problem, result, lines):
                 result.schedule.jobs[visit.job].robots[robot.name]]
             for text, start in zip((robot.name, visit.job, operation), starts, strict=True):
                 assert line[start:start + len(text) + 1] == text + ' ', (header, line)
-            travel = (f'{float(visit.travel_start):g}-{float(visit.arrival):g}'
-                      if visit.arrival > visit.travel_start else '-')
-            numbers = (travel, f'{float(visit.start):g}', f'{float(visit.end):g}')
+            left, arrival, start, end = decimals(visit.travel_start, visit.arrival,
+                                                 visit.start, visit.end)
+            travel = f'{left}-{arrival}' if visit.arrival > visit.travel_start else '-'
+            numbers = (travel, start, end)
             for text, end in zip(numbers, ends, strict=True):
                 assert line[end - len(text) - 1:end] == ' ' + text, (header, line)
             assert len(line) == ends[-1], (header, line)
@@ -271,3 +276,68 @@ def test_table_columns_line_up_for_generated_scenarios(seed):
     problem = scenario_from_text(yaml.safe_dump(random_scenario(seed)), name=f'gen-{seed}')
     result, lines = table_of(problem)
     check_columns(problem, result, lines)
+
+
+# --- checking a file without solving -----------------------------------------------------
+
+BEAM = (DATA / 'beam_drive.yaml').read_text()
+
+FRAGMENT = FRAGMENTS / 'solar_panel_second_panel.yaml'
+
+
+def test_check_says_a_scenario_is_fine_and_solves_nothing():
+    run = fjsp_solve('--check', PAPER)
+    assert (run.returncode, run.stderr) == (0, '')
+    assert run.stdout == f'{PAPER}: fine: 12 jobs, 4 robots, 12 locations\n'
+
+
+def test_check_names_every_problem(tmp_path):
+    bad = tmp_path / 'bad.yaml'
+    bad.write_text(BEAM.replace('type: Crane, speed', 'type: Crain, speed')
+                   .replace('start_location: dock, release', 'start_location: dok, release')
+                   + 'locomote: drive\n')
+    run = fjsp_solve('--check', bad)
+    assert (run.returncode, run.stdout) == (2, '')
+    assert run.stderr.splitlines()[1:] == [
+        f"  - {bad}: robot 'C1': unknown robot type 'Crain'; did you mean 'Crane'?",
+        f"  - {bad}: location 'dok' (start of robot 'W1') has no distance to any other "
+        "location; did you mean 'dock'?",
+        f"  - {bad}: job 'Join' cannot be staffed: plan 0 ['grip' (0), 'weld' (1)] needs 2 "
+        "distinct robots able to do its operations; 1 can (not counting 'C1', of unknown "
+        "type)"]
+
+
+def test_warnings_are_printed_and_the_plan_goes_on(tmp_path):
+    """The travel type is called `drive` and nothing says so: travel is free, so said."""
+    beam = tmp_path / 'beam.yaml'
+    beam.write_text(BEAM)
+    warning = ("fjsp-solve: warning: distances and the start locations of robots 'C1', 'W1' "
+               'are given, but no operation type is the travel type')
+    for args in (('--check',), ('--solver', 'greedy')):
+        run = fjsp_solve(*args, beam)
+        assert run.returncode == 0, run.stderr
+        assert run.stderr.startswith(warning) and "did you mean 'locomote: drive'?" in run.stderr
+    beam.write_text(BEAM + 'locomote: drive\n')
+    assert fjsp_solve('--check', beam).stderr == ''
+
+
+def test_a_fragment_is_checked_against_its_scenario(tmp_path):
+    run = fjsp_solve('--check', FRAGMENT, '--fragment-of', PAPER)
+    assert (run.returncode, run.stderr) == (0, ''), run.stderr
+    assert run.stdout == (f"{FRAGMENT}: fine: adds 12 jobs ('M1_p2', 'M2_p2', 'Ja_p2' and 9 "
+                          f'more) to {PAPER}\n')
+    bad = tmp_path / 'more.yaml'
+    bad.write_text('jobs: [{name: Ja, location: far, plans: [[0]]}]\n'
+                   'precedence: [[Ad, Xx]]\n')
+    run = fjsp_solve('--check', bad, '--fragment-of', PAPER)
+    assert (run.returncode, run.stdout) == (2, '')
+    assert run.stderr.splitlines() == [
+        'fjsp-solve: invalid fragment:',
+        "  - job 'Ja' is defined 2 times",
+        "  - location 'far' (job 'Ja') has no distance to any other location",
+        "  - precedence arc ('Ad', 'Xx') names unknown job 'Xx'"]
+
+
+def test_fragment_of_goes_with_check():
+    run = fjsp_solve(FRAGMENT, '--fragment-of', PAPER)
+    assert run.returncode == 2 and '--fragment-of goes with --check' in run.stderr

@@ -1,10 +1,12 @@
 """The test harness's waits: a condition on something the observer has not heard yet (no
 mission status, no plan) is not yet true, and a timeout names what it raised."""
 
+import re
 from types import SimpleNamespace
 
 import pytest
 
+from fjsp_msgs.msg import MissionStatus
 from fjsp_planner import testing
 from fjsp_planner.launcher.listener import Listener
 
@@ -69,3 +71,92 @@ def test_a_timeout_with_every_node_running_says_only_what_it_waited_for(monkeypa
     with pytest.raises(pytest.fail.Exception) as failure:
         Stopped({'planner': None}).wait_for(lambda o: False, 1, 'a healthy fleet')
     assert str(failure.value).endswith('a healthy fleet; last mission status: None')
+
+
+class Ended(testing.FleetHarness):
+    """A harness whose observer heard the mission end in `state`, without a ROS context."""
+
+    def __init__(self, state, reasons):
+        self.observer = Unheard()
+        self.observer.status = SimpleNamespace(state=state, mission_id='m1', jobs_done=5,
+                                               jobs_total=12, blocked_reasons=reasons)
+        self.processes = {}
+        self.problem = SimpleNamespace(jobs=[])
+
+
+@pytest.mark.parametrize(('state', 'reasons', 'said'), [
+    (MissionStatus.STATE_FAILED, ["job 'Aa' cannot be staffed", 'blocked for 20 s'],
+     "mission 'm1' ended FAILED instead of completing (5/12 jobs done): job 'Aa' cannot be "
+     'staffed; blocked for 20 s'),
+    (MissionStatus.STATE_CANCELLED, [],
+     "mission 'm1' ended CANCELLED instead of completing (5/12 jobs done): no reason given"),
+])
+def test_a_mission_that_ended_undone_fails_the_check_at_once(monkeypatch, state, reasons,
+                                                               said):
+    """The wait ends as soon as the status says the mission ended; it used to wait out the
+    whole timeout for a COMPLETE that could not come any more."""
+    waited = []
+
+    def wait(self, predicate, timeout):
+        waited.append(timeout)
+        return predicate()
+
+    monkeypatch.setattr(Listener, 'wait_for', wait)
+    with pytest.raises(pytest.fail.Exception) as failure:
+        Ended(state, reasons).check_mission_complete(timeout=600)
+    assert str(failure.value) == said
+    assert waited == [600]
+
+
+@pytest.fixture
+def environment(monkeypatch):
+    """No domain setting of the caller's: each test sets its own."""
+    for name in ('ROS_DOMAIN_ID', testing.DOMAINS_VARIABLE):
+        monkeypatch.delenv(name, raising=False)
+    return monkeypatch
+
+
+def test_the_domain_is_the_one_ros_domain_id_names(environment):
+    environment.setenv('ROS_DOMAIN_ID', '231')
+    claim = testing.DomainClaim()
+    try:
+        assert claim.domain == 231
+        with pytest.raises(RuntimeError, match='ROS_DOMAIN_ID=231 is in use by another fleet '
+                                               'of tests on this machine; for several fleets '
+                                               'at once set FJSP_TEST_DOMAINS'):
+            testing.DomainClaim()
+    finally:
+        claim.release()
+    testing.DomainClaim().release()            # free again once released
+
+
+def test_a_range_of_domains_gives_each_fleet_its_own(environment):
+    environment.setenv('ROS_DOMAIN_ID', '231')
+    environment.setenv(testing.DOMAINS_VARIABLE, '229-230')
+    claims = [testing.DomainClaim(), testing.DomainClaim()]
+    try:
+        assert sorted(c.domain for c in claims) == [229, 230]
+        with pytest.raises(RuntimeError, match=r'every ROS domain id 229..230 '
+                                               r'\(FJSP_TEST_DOMAINS\) is in use'):
+            testing.DomainClaim()
+    finally:
+        for claim in claims:
+            claim.release()
+
+
+def test_without_a_setting_the_domain_is_from_the_default_range(environment):
+    claim = testing.DomainClaim()
+    claim.release()
+    assert claim.domain in testing.DOMAINS
+
+
+@pytest.mark.parametrize(('variable', 'value', 'message'), [
+    ('ROS_DOMAIN_ID', 'ten', "ROS_DOMAIN_ID='ten': expected an id within 0..232"),
+    ('ROS_DOMAIN_ID', '300', "ROS_DOMAIN_ID='300': expected an id within 0..232"),
+    (testing.DOMAINS_VARIABLE, '200-100', "FJSP_TEST_DOMAINS='200-100': expected first-last"),
+    (testing.DOMAINS_VARIABLE, '1-999', "FJSP_TEST_DOMAINS='1-999': expected first-last"),
+])
+def test_an_unusable_domain_setting_is_named(environment, variable, value, message):
+    environment.setenv(variable, value)
+    with pytest.raises(RuntimeError, match=re.escape(message)):
+        testing.DomainClaim()

@@ -16,7 +16,7 @@ OK, WARN, ERROR, STALE = (DiagnosticStatus.OK, DiagnosticStatus.WARN, Diagnostic
     (RobotMode.WORKING, {'job': 'Ja'}, OK, 'working Ja'),
     (RobotMode.IDLE, {}, OK, 'idle'),
     (RobotMode.WORKING, {'job': 'Ja', 'late_by': 3.0, 'late_threshold': 2.0}, WARN,
-     'late: Ja ends 3.00 units after the plan'),
+     'late: Ja ends 3 units after the plan'),
     (RobotMode.WORKING, {'job': 'Ja', 'late_by': 1.0, 'late_threshold': 2.0}, OK, 'working Ja'),
     (RobotMode.IDLE, {'refusal': "plan makes 'R1' a 'Drone'"}, WARN,
      "refuses its plan: plan makes 'R1' a 'Drone'"),

@@ -17,6 +17,10 @@ from fjsp_planner.testing import fjsp_fleet, fjsp_network, ros_domain  # noqa: E
 
 HERE = os.path.dirname(__file__)
 
+# This suite runs several fleets at once (module-scoped fleets beside each test's own): they
+# take ids of a range, one each, even where the shell has a ROS_DOMAIN_ID of its own.
+os.environ.setdefault(testing.DOMAINS_VARIABLE, f'{testing.DOMAINS[0]}-{testing.DOMAINS[-1]}')
+
 
 def pytest_collection_modifyitems(items) -> None:
     """Every test here starts processes: marked `integration`, so the fast loop

@@ -123,7 +123,7 @@ jobs:
     out, err = process.communicate(timeout=60)
     assert process.returncode == 2, out + err
     assert "robot 'R2': unknown robot type 'Nope'" in err
-    assert "no distance between locations 'a' and 'b'" in err
+    assert 'no distances are given, but robots travel' in err
     assert not (tmp_path / 'out').exists()
 
     # Robot names become node and service names: one that cannot is refused before anything.

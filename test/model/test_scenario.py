@@ -9,7 +9,12 @@ import pytest
 import yaml
 
 from fjsp_planner.model.problem import ProblemError
-from fjsp_planner.model.scenario import ScenarioError, load_scenario, parse_scenario
+from fjsp_planner.model.scenario import (
+    ScenarioError,
+    load_scenario,
+    parse_scenario,
+    scenario_warnings,
+)
 
 from repo_paths import PAPER
 
@@ -106,7 +111,9 @@ INVALID = [
     ('negative distance', ('distances', 'table', 'rows', 0, 2), -4,
      "distance 'M1'-'Ja': -4 is outside [0, 1e+06]"),
     ('asymmetric distance', ('distances', 'table', 'rows', 0, 2), 44, 'not symmetric'),
-    ('missing distances', ('distances',), DELETE, "no distance between locations 'Aa' and"),
+    ('missing distances', ('distances',), DELETE,
+     "no distances are given, but robots travel (operation type 'locomote' (3)) between 12 "
+     "locations: 'distances' must give one between every two of them"),
     ('non-number speed', ('robots', 0, 'speed'), 'fast',
      "robot 'Assembler' speed: expected a finite number, got 'fast'"),
     ('zero speed', ('robots', 0, 'speed'), 0,
@@ -148,7 +155,7 @@ INVALID = [
     ('fraction dividing by zero', ('robots', 0, 'speed'), '1/0',
      "robot 'Assembler' speed: '1/0' divides by zero"),
     ('derived travel too long', ('robot_types', 'Assembler', 'locomote'), 10**6,
-     "robot 'Assembler': travelling from 'Ab' to 'Md' would take 1.93333e+06 units "
+     "robot 'Assembler': travelling from 'Ab' to 'Md' would take 1933333.333 units "
      '(distance 58 x locomote efficiency 1e+06 / speed 30), more than the limit of 1e+06'),
     # Names and sizes a file can make enormous cheaply.
     ('name that is a list', ('jobs', 0, 'name'), ['M', 1],
@@ -186,8 +193,9 @@ def test_a_job_no_robot_can_do():
     data['jobs'][0]['plans'] = [[4]]
     with pytest.raises(ProblemError) as caught:
         parse_scenario(data)
-    assert ("job 'M1' cannot be staffed: plan 0 ['solder' (4)] needs 1 distinct robots"
-            in str(caught.value))
+    assert caught.value.problems == [
+        "job 'M1' cannot be staffed: plan 0 ['solder' (4)] needs a robot able to do it; no "
+        'robot can']
 
 
 def test_every_problem_is_reported_at_once(paper_data):
@@ -290,7 +298,7 @@ def test_panels_that_make_travel_too_long(tmp_path):
     with pytest.raises(ScenarioError) as caught:
         load_scenario(PAPER, panels=50, shift=30000)
     assert any("robot 'Assembler': travelling from 'Ab' of panel 1 to 'Md' of panel 50 would "
-               'take 4.90019e+06 units (distance 1.47006e+06 x locomote efficiency 100 / '
+               'take 4900193.333 units (distance 1.47006e+06 x locomote efficiency 100 / '
                'speed 30), more than the limit of 1e+06' in p
                for p in caught.value.problems), caught.value.problems
 
@@ -329,3 +337,118 @@ def test_a_file_larger_than_the_limit(tmp_path):
     path.write_bytes(b'#' * (4 * 2**20 + 1))
     with pytest.raises(ScenarioError, match='larger than the limit of 4194304 bytes'):
         load_scenario(path)
+
+
+# --- checks that help: what to write instead ---------------------------------------------
+
+BEAM = {
+    'name': 'beam',
+    'operation_types': {0: 'grip', 1: 'weld', 2: 'locomote'},
+    'robot_types': {'Crane': {'grip': 2, 'locomote': 10},
+                    'Welder': {'grip': 4, 'weld': 3, 'locomote': 2}},
+    'robots': [{'name': 'C1', 'type': 'Crane', 'speed': 5, 'start_location': 'dock'},
+               {'name': 'W1', 'type': 'Welder', 'speed': 10, 'start_location': 'dock',
+                'release_time': 1}],
+    'jobs': [{'name': 'Lift', 'location': 'site', 'plans': [['grip']]},
+             {'name': 'Join', 'location': 'site', 'plans': [['grip', 'weld']]},
+             {'name': 'Check', 'location': 'yard', 'plans': [['weld']]}],
+    'distances': {'pairs': [['dock', 'site', 5], ['dock', 'yard', 3], ['site', 'yard', 2]]},
+    'precedence': [['Lift', 'Join']],
+    'holding': [['Lift', 'Join', 'grip']],
+}
+
+# (what is wrong, where it is edited, the new value, every problem said, in order)
+UNHELPFUL = [
+    ('misspelt robot type', ('robots', 0, 'type'), 'Crain',
+     ["robot 'C1': unknown robot type 'Crain'; did you mean 'Crane'?",
+      "job 'Join' cannot be staffed: plan 0 ['grip' (0), 'weld' (1)] needs 2 distinct robots "
+      "able to do its operations; 1 can (not counting 'C1', of unknown type)"]),
+    ('misspelt operation type in a plan', ('jobs', 0, 'plans'), [['grp']],
+     ["job 'Lift': unknown operation type 'grp'; did you mean 'grip'?"]),
+    ('misspelt operation type of a holding arc', ('holding', 0), ['Lift', 'Join', 'gripp'],
+     ["holding arc ('Lift', 'Join'): unknown operation type 'gripp'; did you mean 'grip'?"]),
+    ('misspelt efficiency', ('robot_types', 'Crane', 'wled'), 3,
+     ["robot type 'Crane': unknown operation type 'wled'; did you mean 'weld'?"]),
+    ('misspelt locomote', ('locomote',), 'locomot',
+     ["locomote: unknown operation type 'locomot'; did you mean 'locomote'?"]),
+    ('misspelt job in precedence', ('precedence', 0), ['Lift', 'Jion'],
+     ["precedence arc ('Lift', 'Jion') names unknown job 'Jion'; did you mean 'Join'?"]),
+    ('misspelt job in a holding arc', ('holding', 0), ['Lfit', 'Join', 'grip'],
+     ["holding arc ('Lfit', 'Join', 'grip' (0)) names unknown job 'Lfit'; did you mean "
+      "'Lift'?"]),
+    ('misspelt robot of an override', ('time_overrides',),
+     [{'robot': 'w1', 'operation': 'weld', 'time': 2}],
+     ["time override names unknown robot 'w1'; did you mean 'W1'?"]),
+    ('unknown start location, named once', ('robots', 0, 'start_location'), 'dok',
+     ["location 'dok' (start of robot 'C1') has no distance to any other location; did you "
+      "mean 'dock'?"]),
+    ('misspelt job location', ('jobs', 2, 'location'), 'yrd',
+     ["location 'yrd' (job 'Check') has no distance to any other location; did you mean "
+      "'yard'?"]),
+    ('no distances at all', ('distances',), DELETE,
+     ["no distances are given, but robots travel (operation type 'locomote' (2)) between 3 "
+      "locations: 'distances' must give one between every two of them"]),
+    ('one distance missing', ('distances', 'pairs'), [['dock', 'site', 5], ['dock', 'yard', 3]],
+     ["no distance between locations 'site' and 'yard'"]),
+    ('a distance given twice', ('distances', 'pairs'),
+     [['dock', 'site', 5], ['dock', 'yard', 3], ['site', 'yard', 2], ['yard', 'dock', 2.5]],
+     ["distance 'yard'-'dock' is given twice: 3 and 2.500"]),
+    ('a job one robot short', ('jobs', 1, 'plans'), [['weld', 'weld']],
+     ["holding arc ('Lift', 'Join', 'grip' (0)) needs operation type 'grip' (0) but job "
+      "'Join' has no such operation", "job 'Join' cannot be staffed: plan 0 ['weld' (1) x2] "
+      'needs 2 distinct robots able to do its operations; 1 can']),
+    ('a job no robot can do', ('operation_types', 3), 'paint', None),
+]
+
+
+@pytest.mark.parametrize('why, path, value, expected', UNHELPFUL,
+                         ids=[row[0] for row in UNHELPFUL])
+def test_problems_say_what_to_write_instead(why, path, value, expected):
+    data = copy.deepcopy(BEAM)
+    _edit(data, path, value)
+    if why == 'a job no robot can do':
+        data['jobs'][2]['plans'] = [['paint']]
+        expected = ["job 'Check' cannot be staffed: plan 0 ['paint' (3)] needs a robot able "
+                    'to do it; no robot can']
+    with pytest.raises(ProblemError) as caught:
+        parse_scenario(data)
+    assert caught.value.problems == expected
+
+
+def test_the_beam_is_fine():
+    problem = parse_scenario(copy.deepcopy(BEAM))
+    assert scenario_warnings(problem) == []
+
+
+TRAVEL_FREE = ("are given, but no operation type is the travel type (none is called "
+               "'locomote', and no 'locomote:' names one): travel takes no time")
+
+# (what is written, the warning)
+UNMEANT = [
+    ('travel type called drive', {
+        'operation_types': {0: 'grip', 1: 'weld', 2: 'drive'},
+        'robot_types': {'Crane': {'grip': 2, 'drive': 10},
+                        'Welder': {'grip': 4, 'weld': 3, 'drive': 2}}},
+     f"distances and the start locations of robots 'C1', 'W1' {TRAVEL_FREE}; did you mean "
+     "'locomote: drive'?"),
+    ('no travel type, distances only', {
+        'operation_types': {0: 'grip', 1: 'weld'},
+        'robot_types': {'Crane': {'grip': 2}, 'Welder': {'grip': 4, 'weld': 3}},
+        'robots': [{'name': 'C1', 'type': 'Crane'}, {'name': 'W1', 'type': 'Welder'}]},
+     f"distances {TRAVEL_FREE}; name it with 'locomote: <operation type>', or call it "
+     "'locomote'"),
+    ('no travel type, one start location only', {
+        'operation_types': {0: 'grip', 1: 'weld', 2: 'fly'},
+        'robot_types': {'Crane': {'grip': 2, 'fly': 1}, 'Welder': {'grip': 4, 'weld': 3}},
+        'robots': [{'name': 'C1', 'type': 'Crane', 'start_location': 'site'},
+                   {'name': 'W1', 'type': 'Welder'}],
+        'distances': None},
+     f"the start location of robot 'C1' {TRAVEL_FREE}; did you mean 'locomote: fly'?"),
+]
+
+
+@pytest.mark.parametrize('why, changes, warning', UNMEANT, ids=[row[0] for row in UNMEANT])
+def test_what_probably_is_not_meant_is_a_warning(why, changes, warning):
+    data = {**copy.deepcopy(BEAM), **changes}
+    data = {key: value for key, value in data.items() if value is not None}
+    assert scenario_warnings(parse_scenario(data)) == [warning]

@@ -16,6 +16,8 @@ is cheap, so each broken row moves one number just past a bound.
     H    P      [0]            C hold        [13, 17]  C travels Q->P in 8, one to spare
 """
 
+import copy
+import pickle
 from dataclasses import replace
 from fractions import Fraction
 
@@ -142,8 +144,8 @@ BROKEN = [
                  ["robot 'A': job 'J2' starts at 11 but the robot ends 'W1' at 8 and travels "
                   "4 from 'P' to 'Q', arriving at 12"], id='travel between jobs'),
     pytest.param(schedule({'W1': assign('W1', Fraction(4999, 1000), 8, {'A': 0, 'B': 1})}),
-                 ["robot 'B': first job 'W1' starts at 4999/1000 but the robot is released at "
-                  "13/3 at 'S' and arrives at 'P' at 5"], id='release and travel from start'),
+                 ["robot 'B': first job 'W1' starts at 4.999 but the robot is released at "
+                  "4.333 at 'S' and arrives at 'P' at 5"], id='release and travel from start'),
     pytest.param(schedule({'F': assign('F', 0, 5, {'C': 0})}),
                  ["fixed job 'F' has end 5 but is fixed with 4"], id='fixed job moved'),
     pytest.param(schedule({'W1': assign('W1', 5, 8, {'B': 1}, plan=1)}, {'A': ('J1', 'J2')}),
@@ -180,3 +182,20 @@ def test_problem_with_changed_release_is_checked_exactly():
     messages = validate(make_problem(robots=tuple(robots)), schedule())
     assert len(messages) == 1
     assert "robot 'B': first job 'W1' starts at 5" in messages[0]
+
+
+def test_times_read_as_decimals_and_stay_exact_in_the_data():
+    """A start 1/10^9 before the arrival it must wait for: written with the places that tell
+    the two apart, never as a fraction; the exact values stay with the message."""
+    early = Fraction(5) - Fraction(1, 10 ** 9)
+    messages = validate(make_problem(), schedule({'W1': assign('W1', early, 8,
+                                                                {'A': 0, 'B': 1})}))
+    assert messages == ["robot 'B': first job 'W1' starts at 4.999999999 but the robot is "
+                        "released at 4.333333333 at 'S' and arrives at 'P' at 5"]
+    assert messages[0].exact == ("robot 'B': first job 'W1' starts at 4999999999/1000000000 "
+                                 "but the robot is released at 13/3 at 'S' and arrives at "
+                                 "'P' at 5")
+    assert messages[0].values['start'] == early
+    assert messages[0].values['arrival'] == 5
+    for copied in (copy.deepcopy(messages[0]), pickle.loads(pickle.dumps(messages[0]))):
+        assert copied == messages[0] and copied.exact == messages[0].exact

@@ -16,7 +16,7 @@ def test_replay_prints_the_summary_and_story_and_draws_the_chart(tmp_path, capsy
     assert f'recording {path}: {len(faulty_mission())} messages' in out
     assert 'complete: 3/3 jobs done (planner: 3/3); 2 revisions, 1 aborted attempt, 1 voided' \
         in out
-    assert "t=    5.00  job J2 aborted: robot 'C' failed" in out
+    assert "t=       5  job J2 aborted: robot 'C' failed" in out
     assert (tmp_path / 'charts' / f'{MISSION}.replay.png').is_file()
     assert (tmp_path / 'charts' / f'{MISSION}.replay.json').is_file()
 

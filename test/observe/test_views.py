@@ -3,12 +3,25 @@ timeline drawn by the page and the PNG, terminal frames printed only on change."
 
 import math
 
-from fjsp_common.vocabulary import EventKind, RobotMode
+import pytest
+
+from fjsp_common.vocabulary import EventKind, MissionState, RobotMode
 from fjsp_planner.observe import text, views
 from fjsp_planner.observe.history import FleetHistory
 from fjsp_planner.observe.mission_chart import write_mission
 
-from mission_facts import MISSION, at, event, faulty_mission, heartbeats, plan, state, task, work
+from mission_facts import (
+    MISSION,
+    at,
+    event,
+    faulty_mission,
+    heartbeats,
+    plan,
+    state,
+    status,
+    task,
+    work,
+)
 
 
 def fleet_of(facts) -> FleetHistory:
@@ -59,7 +72,7 @@ def test_a_waiting_robot_says_what_it_waits_for():
               state('B', 3.5, mode=RobotMode.WAITING, job='J2', location='at_J2')]
     fleet = fleet_of(facts)
     b = row_of(views.robot_rows(fleet, fleet.missions[MISSION], at(3.6)), 'B')
-    assert b['detail'] == 'J2: waits for A to arrive, J1 to be done, planned start t=4.0'
+    assert b['detail'] == 'J2: waits for A to arrive, J1 to be done, planned start t=4'
 
 
 def test_a_predecessor_done_before_the_revision_is_not_waited_for():
@@ -71,7 +84,7 @@ def test_a_predecessor_done_before_the_revision_is_not_waited_for():
               state('B', 3.5, mode=RobotMode.WAITING, job='J2', location='at_J2', revision=2)]
     fleet = fleet_of(facts)
     b = row_of(views.robot_rows(fleet, fleet.missions[MISSION], at(3.6)), 'B')
-    assert b['detail'] == 'J2: waits for A to arrive, planned start t=4.0'
+    assert b['detail'] == 'J2: waits for A to arrive, planned start t=4'
 
 
 def test_a_holding_robot_says_whom_it_waits_for_to_finish():
@@ -124,9 +137,29 @@ def test_a_frame_is_new_only_when_something_noticeable_changed():
     assert changed != key
 
 
+@pytest.mark.parametrize(('state', 'label'), [
+    (MissionState.FAILED, 'Failed'),
+    (MissionState.CANCELLED, 'Cancelled'),
+    (MissionState.BLOCKED, 'Blocked'),
+    (MissionState.WAITING_FOR_ROBOTS, 'Waiting'),
+])
+def test_the_reasons_are_labelled_by_what_the_mission_is_in(state, label):
+    """A failed mission's reason is why it failed, a cancel's why it was cancelled: neither
+    is a block."""
+    facts = [plan(1, 0, [task('A', 'J1', 0, 5)]),
+             status(2, state, 0, 1, blocked=["job 'J1' cannot be staffed"])]
+    fleet = fleet_of(facts)
+    mission = fleet.missions[MISSION]
+    header = views.header(mission, at(3))
+    assert header['reasons_label'] == label
+    shown, _ = text.frame(header, views.robot_rows(fleet, mission, at(3)))
+    assert f"  {label.lower()}: job 'J1' cannot be staffed" in shown.splitlines()
+
+
 def test_story_lines_carry_their_schedule_time():
     assert text.story_line({'time': 5.5, 'text': 'revision 2 planned'}) == \
-        't=    5.50  revision 2 planned'
+        't=   5.500  revision 2 planned'
+    assert text.story_line({'time': 5, 'text': 'job J1 done'}) == 't=       5  job J1 done'
     assert text.story_line({'time': None, 'text': 'x'}).endswith('?  x')
 
 

@@ -6,7 +6,8 @@ Free of ROS, so the domain core and tools use them too:
 - `fleet`: node names and the defaults the whole fleet shares (heartbeat period and timeout);
 - `clock`: one mission's schedule clock, wall seconds <-> schedule units;
 - `revisions`: which attempt at a job a report is about, and whether it still counts;
-- `parameters`: a node parameter's one definition (`ParameterSpec`).
+- `parameters`: a node parameter's one definition (`ParameterSpec`);
+- `decimals`: how every time a person reads is written (decimals, never raw fractions).
 
 With ROS:
 

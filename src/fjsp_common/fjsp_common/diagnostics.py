@@ -14,6 +14,7 @@ from collections.abc import Iterable, Mapping
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
+from fjsp_common.decimals import decimal
 from fjsp_common.vocabulary import MissionState, RobotMode
 
 DIAGNOSTICS_TOPIC = '/diagnostics'
@@ -63,7 +64,7 @@ def robot_diagnostic(name: str, robot: str, mode: RobotMode | None, *, job: str 
         level, message = DiagnosticStatus.WARN, f'refuses its plan: {refusal}'
     elif late_by > late_threshold:
         level = DiagnosticStatus.WARN
-        message = f'late: {job or "its operation"} ends {late_by:.2f} units after the plan'
+        message = f'late: {job or "its operation"} ends {decimal(late_by)} units after the plan'
     else:
         level = DiagnosticStatus.OK
         message = f'{mode} {job}'.strip()

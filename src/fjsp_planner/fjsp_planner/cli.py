@@ -17,8 +17,9 @@ import threading
 from fractions import Fraction
 from pathlib import Path
 
+from fjsp_common.decimals import decimal, decimals
 from fjsp_planner.model.limits import MAX_WORKERS
-from fjsp_planner.model.problem import ProblemError
+from fjsp_planner.model.problem import ProblemError, listed
 from fjsp_planner.model.schedule import Result
 from fjsp_planner.model.validate import validate
 
@@ -48,8 +49,16 @@ def main(argv=None) -> int:
     parser.add_argument('--mip-backend', choices=('SCIP', 'HIGHS'), default='SCIP')
     parser.add_argument('--json', type=Path, metavar='OUT', help='write the result as JSON')
     parser.add_argument('--gantt', type=Path, metavar='OUT.png', help='draw the schedule')
+    parser.add_argument('--check', action='store_true',
+                        help='only check the file: exit 0 if it is fine, 2 naming every '
+                        'problem; nothing is solved')
+    parser.add_argument('--fragment-of', type=Path, metavar='SCENARIO',
+                        help='with --check: the file is a fragment of jobs to add to a '
+                        'mission of SCENARIO (as `mission add` sends it)')
     args = parser.parse_args(argv)
-    return _in_worker(lambda: _plan(args))
+    if args.fragment_of is not None and not args.check:
+        parser.error('--fragment-of goes with --check')
+    return _in_worker(lambda: _check(args) if args.check else _plan(args))
 
 
 def _interrupted(signum, frame):
@@ -91,10 +100,8 @@ def _plan(args) -> int:
     try:
         problem = _load(args)
     except ProblemError as error:
-        print('fjsp-solve: invalid scenario:', file=sys.stderr)
-        for problem_text in error.problems:
-            print(f'  - {problem_text}', file=sys.stderr)
-        return EXIT_BAD_INPUT
+        return _invalid('scenario', error)
+    _warn(args, problem)
     _stage = 'solving'
     result = solve(problem, solver=args.solver, time_limit=args.time_limit,
                    workers=args.workers, mip_backend=args.mip_backend)
@@ -117,11 +124,58 @@ def _plan(args) -> int:
             from fjsp_planner.observe.plan_chart import draw_gantt
 
             draw_gantt(problem, result.schedule, args.gantt,
-                       title=f'{problem.name}: makespan {_number(result.makespan):g}')
+                       title=f'{problem.name}: makespan {decimal(result.makespan)}')
     except OSError as error:
         print(f'fjsp-solve: cannot write {error.filename}: {error.strerror}', file=sys.stderr)
         return EXIT_BAD_INPUT
     return 0 if result.schedule is not None else 1
+
+
+def _check(args) -> int:
+    """Read the scenario (or the fragment against its scenario) and say what is wrong."""
+    global _stage
+    _stage = 'checking'
+    from fjsp_planner.model.extension import extend
+    from fjsp_planner.model.limits import read_input_file
+    from fjsp_planner.model.scenario import load_scenario
+
+    try:
+        if args.fragment_of is None:
+            problem = _load(args)
+        else:
+            problem = load_scenario(args.fragment_of, panels=args.panels, shift=args.shift)
+    except ProblemError as error:
+        return _invalid('scenario', error)
+    if args.fragment_of is None:
+        _warn(args, problem)
+        print(f'{args.scenario}: fine: {len(problem.jobs)} jobs, {len(problem.robots)} '
+              f'robots, {len(problem.locations())} locations')
+        return 0
+    try:
+        extended, added = extend(problem, read_input_file(args.scenario, 'fragment'))
+    except ProblemError as error:
+        return _invalid('fragment', error)
+    _warn(args, extended)
+    print(f'{args.scenario}: fine: adds {len(added)} job{"s" if len(added) != 1 else ""} '
+          f'({listed(added)}) to {args.fragment_of}')
+    return 0
+
+
+def _invalid(what: str, error: ProblemError) -> int:
+    print(f'fjsp-solve: invalid {what}:', file=sys.stderr)
+    for problem_text in error.problems:
+        print(f'  - {problem_text}', file=sys.stderr)
+    return EXIT_BAD_INPUT
+
+
+def _warn(args, problem) -> None:
+    """A scenario's warnings (`scenario_warnings`), on stderr; `.fjs` files have none."""
+    if Path(args.scenario).suffix == '.fjs':
+        return
+    from fjsp_planner.model.scenario import scenario_warnings
+
+    for warning in scenario_warnings(problem):
+        print(f'fjsp-solve: warning: {warning}', file=sys.stderr)
 
 
 def _load(args):
@@ -139,10 +193,11 @@ def _load(args):
 
 def status_line(result: Result) -> str:
     parts = [f'status {result.status.value}', f'solver {result.solver}']
+    makespan, bound = decimals(result.makespan, result.lower_bound)
     if result.makespan is not None:
-        parts.append(f'makespan {_number(result.makespan):g}')
+        parts.append(f'makespan {makespan}')
     if result.lower_bound is not None:
-        parts.append(f'bound {_number(result.lower_bound):g}')
+        parts.append(f'bound {bound}')
     if result.gap is not None:
         parts.append(f'gap {100 * result.gap:.1f}%')
     parts.append(f'time {result.solve_seconds:.2f} s')
@@ -157,10 +212,11 @@ def format_table(problem, result: Result) -> str:
     for robot in problem.robots:
         for visit in result.schedule.visits(problem, robot.name):
             q = result.schedule.jobs[visit.job].robots[robot.name]
-            travel = (f'{_number(visit.travel_start):g}-{_number(visit.arrival):g}'
-                      if visit.arrival > visit.travel_start else '-')
-            rows.append((robot.name, visit.job, problem.operation_types[q], travel,
-                         f'{_number(visit.start):g}', f'{_number(visit.end):g}'))
+            left, arrival, start, end = decimals(visit.travel_start, visit.arrival,
+                                                 visit.start, visit.end)
+            travel = f'{left}-{arrival}' if visit.arrival > visit.travel_start else '-'
+            rows.append((robot.name, visit.job, problem.operation_types[q], travel, start,
+                         end))
         if not result.schedule.sequences.get(robot.name):
             idle.add(len(rows))
             rows.append((robot.name, '(no jobs)'))

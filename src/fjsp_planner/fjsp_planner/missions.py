@@ -29,6 +29,8 @@ import uuid
 from dataclasses import dataclass
 from pathlib import Path
 
+from fjsp_common.decimals import decimal, decimals
+
 RESEND = 1.0
 """Seconds without an answer after which a request is sent again."""
 SEND_TIMEOUT = 10.0
@@ -327,13 +329,14 @@ def describe_feedback(feedback) -> str:
     state = STATE_FROM_MSG.get(feedback.state, f'state {feedback.state}')
     line = (f'{feedback.mission_id}: {state}, revision {feedback.plan_revision}, '
             f'{feedback.jobs_done}/{feedback.jobs_total} jobs done, {feedback.jobs_running} '
-            f'running, makespan planned {feedback.planned_makespan:.2f} projected '
-            f'{feedback.projected_makespan:.2f}, t={feedback.elapsed:.1f}')
+            'running, makespan planned {} projected {}, t={}'.format(
+                *decimals(feedback.planned_makespan, feedback.projected_makespan,
+                          feedback.elapsed)))
     return line + (': ' + '; '.join(feedback.reasons) if feedback.reasons else '')
 
 
 def describe_result(result: MissionResult) -> str:
-    makespan = f', executed makespan {result.makespan:.2f}' \
+    makespan = f', executed makespan {decimal(result.makespan)}' \
         if math.isfinite(result.makespan) else ''
     return (f'{result.mission_id}: {result.state}, {result.jobs_done}/{result.jobs_total} jobs '
             f'done, {result.revisions} revision(s){makespan}'

@@ -13,10 +13,12 @@ and a test that a robot failure is re-planned to completion reads
         fleet.inject_fault('R1', 'fail')
         fleet.check_mission_complete(timeout=120)
 
-Each fleet gets a ROS_DOMAIN_ID of its own and keeps discovery on this host
-(ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST), so tests never hear each other; its processes are
-stopped (SIGINT, then SIGKILL) whatever the test does. Every wait is bounded and fails the
-test naming what it waited for.
+Each fleet gets a ROS_DOMAIN_ID of its own (`DomainClaim`: the one `ROS_DOMAIN_ID` names,
+or one of the range FJSP_TEST_DOMAINS names, else one of 1..100) and keeps discovery on this
+host (ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST), so tests never hear each other; its processes
+are stopped (SIGINT, then SIGKILL) whatever the test does. Every wait is bounded and fails
+the test naming what it waited for; `check_mission_complete` fails at once when the mission
+ends failed or cancelled.
 
 A fleet can also run across real network links instead (`fjsp_network`, `FleetHarness(...,
 network=...)`): the planner and the monitor on one host, each agent on a host of its own,
@@ -26,6 +28,7 @@ as network namespaces on one bridge whose links a test can cut and restore.
 import dataclasses
 import fcntl
 import math
+import os
 import random
 import signal
 import subprocess
@@ -70,24 +73,36 @@ DDS_VARIABLES = ('ROS_AUTOMATIC_DISCOVERY_RANGE', 'ROS_STATIC_PEERS',
                  'FASTDDS_BUILTIN_TRANSPORTS', 'FASTRTPS_DEFAULT_PROFILES_FILE')
 """The environment that decides whom a DDS participant discovers and how it talks: the
 observer takes them from the fleet's environment, so it sees what the nodes see."""
+UNDONE = {MissionStatus.STATE_FAILED: 'FAILED', MissionStatus.STATE_CANCELLED: 'CANCELLED'}
+"""The ends of a mission that did not complete, by state."""
 CONTROL_HOST = 'control'
 """The host of the planner and the monitor in a fleet across hosts; each agent's host is
 named after its robot."""
 
 DOMAINS = range(1, 101)
-"""ROS domain ids Fast DDS can use on one host (each maps to its own ports)."""
+"""ROS domain ids the fleets of tests take by default (Fast DDS gives each its own ports)."""
+DOMAINS_VARIABLE = 'FJSP_TEST_DOMAINS'
+"""`first-last` (e.g. `150-230`): the ids the fleets of tests take instead, one each."""
+HIGHEST_DOMAIN = 232
+"""The highest ROS domain id Fast DDS can use on Linux."""
 
 
 class DomainClaim:
     """A ROS domain id no other test on this machine uses while the claim is held: each id is
     claimed with an exclusive lock on a file, released by `release` or when the process
     dies. Without it, two test runs at once (two checkouts, CI and a developer) can share a
-    domain and hear each other's robots."""
+    domain and hear each other's robots.
+
+    The id comes from the range FJSP_TEST_DOMAINS names (`150-230`), else from
+    `ROS_DOMAIN_ID` (the one domain a CI job or a shell gave the tests; a second fleet at
+    once cannot have it too), else from DOMAINS. An unusable setting, or no free id, is a
+    RuntimeError saying which and what to do."""
 
     def __init__(self):
-        start = random.randrange(len(DOMAINS))
-        for index in range(len(DOMAINS)):
-            domain = DOMAINS[(start + index) % len(DOMAINS)]
+        domains, source = _test_domains()
+        start = random.randrange(len(domains))
+        for index in range(len(domains)):
+            domain = domains[(start + index) % len(domains)]
             lock = open(f'{tempfile.gettempdir()}/fjsp-ros-domain-{domain}.lock', 'w')  # noqa: SIM115
             try:
                 fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
@@ -96,11 +111,37 @@ class DomainClaim:
                 continue
             self.domain, self._lock = domain, lock
             return
-        raise RuntimeError(f'every ROS domain id {DOMAINS.start}..{DOMAINS.stop - 1} is in '
+        if source == 'ROS_DOMAIN_ID':
+            raise RuntimeError(f'ROS_DOMAIN_ID={domains[0]} is in use by another fleet of '
+                               f'tests on this machine; for several fleets at once set '
+                               f'{DOMAINS_VARIABLE} to a range of ids (e.g. 150-230)')
+        raise RuntimeError(f'every ROS domain id {domains[0]}..{domains[-1]} ({source}) is in '
                            'use by other tests on this machine')
 
     def release(self) -> None:
         self._lock.close()
+
+
+def _test_domains() -> tuple[range, str]:
+    """The domain ids a claim may take, and where they come from."""
+    text = os.environ.get(DOMAINS_VARIABLE, '').strip()
+    if text:
+        first, dash, last = text.partition('-')
+        try:
+            domains = range(int(first), int(last if dash else first) + 1)
+        except ValueError:
+            domains = range(0)
+        if not domains or domains[0] < 0 or domains[-1] > HIGHEST_DOMAIN:
+            raise RuntimeError(f'{DOMAINS_VARIABLE}={text!r}: expected first-last, ids within '
+                               f'0..{HIGHEST_DOMAIN}')
+        return domains, DOMAINS_VARIABLE
+    text = os.environ.get('ROS_DOMAIN_ID', '').strip()
+    if text:
+        if not text.isdigit() or int(text) > HIGHEST_DOMAIN:
+            raise RuntimeError(f'ROS_DOMAIN_ID={text!r}: expected an id within '
+                               f'0..{HIGHEST_DOMAIN}')
+        return range(int(text), int(text) + 1), 'ROS_DOMAIN_ID'
+    return DOMAINS, 'the default range'
 
 
 class Observer(Listener):
@@ -157,6 +198,10 @@ class Observer(Listener):
 
     def complete(self) -> bool:
         return self.status is not None and self.status.state == MissionStatus.STATE_COMPLETE
+
+    def ended_undone(self) -> bool:
+        """The mission ended FAILED or CANCELLED: it will not complete any more."""
+        return self.status is not None and self.status.state in UNDONE
 
     def latest_revision(self) -> int:
         return max((p.revision for p in self.plans), default=0)
@@ -268,10 +313,18 @@ class FleetHarness(Fleet):
     def check_mission_complete(self, timeout: float = 60.0) -> Schedule:
         """Wait for the mission to complete, then check what a user relies on: every job of
         the scenario done exactly once, the timeline the robots ran (rebuilt from their
-        events) valid, and the status agreeing. The executed timeline."""
+        events) valid, and the status agreeing. The executed timeline. A mission that ends
+        failed or cancelled fails the test at once, naming the state and its reasons."""
         problem = self.problem
         jobs = {j.name for j in problem.jobs}
-        self.wait_for(lambda o: o.complete(), timeout, 'the mission to complete')
+        self.wait_for(lambda o: o.complete() or o.ended_undone(), timeout,
+                      'the mission to complete')
+        status = self.observer.status
+        if status.state != MissionStatus.STATE_COMPLETE:
+            reasons = '; '.join(status.blocked_reasons) or 'no reason given'
+            pytest.fail(f"mission '{status.mission_id}' ended {UNDONE[status.state]} instead "
+                        f'of completing ({status.jobs_done}/{status.jobs_total} jobs done): '
+                        f'{reasons}', pytrace=False)
         # The last job-done events and the status saying complete may come in either order;
         # each agent's event history comes when its writer is discovered.
         missing = []

@@ -29,7 +29,16 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from fractions import Fraction
 
-from fjsp_planner.model.problem import FixedJob, Job, Problem, Robot, max_staffed
+from fjsp_common.decimals import decimal
+from fjsp_planner.model.problem import (
+    FixedJob,
+    Job,
+    Problem,
+    Robot,
+    how_many_can,
+    max_staffed,
+    robots_needed,
+)
 from fjsp_planner.model.schedule import JobAssignment, Result, Schedule, Status
 from fjsp_planner.model.validate import validate
 from fjsp_planner.solving.bounds.panel import critical_path_bound
@@ -464,10 +473,9 @@ def _staffing_problems(problem, todo, healthy, kept, failed) -> list[str]:
             staffed = max_staffed(problem, rest_plan, others)
             if staffed < len(rest_plan):
                 held = f' besides the holders {_named(holders)}' if holders else ''
-                shortfalls.append(f'plan {index} {problem.plan_label(plan)} needs '
-                                  f'{len(rest_plan)} distinct robots able to do '
-                                  f'{problem.plan_label(rest_plan)}{held}; {staffed} healthy '
-                                  'can')
+                needed = robots_needed(len(rest_plan), problem.plan_label(rest_plan))
+                shortfalls.append(f'plan {index} {problem.plan_label(plan)} needs {needed}'
+                                  f"{held}; {how_many_can(staffed, 'healthy')}")
         if len(shortfalls) == len(job.plans):
             problems.append(f"job '{job.name}' cannot be staffed: " + '; '.join(shortfalls)
                             + why_short)
@@ -532,7 +540,7 @@ def _pose(problem, state, healthy, todo, fixed, kept, began, carried_to, aborted
         locomote=problem.locomote,
         time_overrides={k: v for k, v in problem.time_overrides.items() if k[0] in healthy},
         fixed=pinned,
-        name=f'{problem.name}@{now}',
+        name=f'{problem.name}@{decimal(now)}',
     )
 
 
@@ -561,7 +569,7 @@ def _raise_on_state_problems(problem: Problem, state: ExecutionState) -> None:
     locations = set(problem.locations())
     problems = []
     if state.now < 0:
-        problems.append(f'now is negative ({state.now})')
+        problems.append(f'now is negative ({decimal(state.now)})')
     for name in sorted(set(state.done) - jobs):
         problems.append(f"done job '{name}' is not a job")
     for name in sorted(set(state.done) & set(state.running)):

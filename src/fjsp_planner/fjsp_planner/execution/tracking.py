@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 from enum import StrEnum
 from fractions import Fraction
 
+from fjsp_common.decimals import decimal, decimals
 from fjsp_common.revisions import void
 from fjsp_common.vocabulary import EventKind, RobotMode
 from fjsp_planner.execution.replan import ExecutionState, RobotSituation
@@ -262,8 +263,9 @@ class MissionTracker:
                                             'reported started')
         if time < started:
             return Verdict(Ignored.UNKNOWN, f"{what}: '{robot}' reports "
-                                            f'operation_done at t={float(time):g} before it '
-                                            f"started at t={float(started):g} (job '{job}')")
+                                            'operation_done at t={} before it started at '
+                                            "t={} (job '{}')".format(*decimals(time, started),
+                                                                     job))
         return None
 
     def record_robot_state(self, robot: str, mode: str, location: str, destination: str,
@@ -389,37 +391,90 @@ class MissionTracker:
         return a.end - a.start
 
     def expected_ends(self, now: float) -> dict[str, Fraction]:
-        """Every job's end: actual if done, else projected by shifting the rest of the plan.
+        """Every job of the current plan's end: actual if done, else projected.
 
-        Jobs not started begin as soon as their predecessors complete and their robots are
-        free and have travelled there, but not before `now`; each takes its planned length.
+        The projection is the plan shifted by what happened (docs/ros-interfaces.md,
+        `projected_makespan`). A running job ends at its start plus its planned length, or
+        when its robots expect, and not before `now`. A job not begun starts at its planned
+        start at the earliest, and not before its predecessors end, nor before each of its
+        robots gets there: from its previous job in the plan's order for it (a holder goes
+        straight on), or, for its first, from where it is or is going and not before its
+        release time, each leg taking its travel time; nor before `now`, unless the reports
+        already fix its start. It takes its planned length. So it equals the plan's ends
+        while everything runs as planned, and never reads earlier than the plan allows.
         """
         now = Fraction(max(now, 0.0))
         ends: dict[str, Fraction] = {}
-        robot_free: dict[str, tuple[Fraction, str | None]] = {}
+        ready = self._robots_free()
+        """robot -> (when it is free, where) for its next job of the plan."""
+        first = set(self.robots)
+        """Robots whose first job of the plan not done is still to come."""
         for name in sorted(self.plan.jobs, key=lambda j: (self.plan.jobs[j].start,
                                                           self.plan.jobs[j].end, j)):
             a, record = self.plan.jobs[name], self.jobs[name]
+            here = self.problem.job(name).location
             if record.end is not None:
                 end = Fraction(record.end)
             elif record.start is not None:
                 end = max(Fraction(record.start) + self._planned_length(name), now,
                           self._reported_end(name))
             else:
-                start = now
-                for before in self.problem.predecessors(name):
-                    start = max(start, ends.get(before, now))
-                here = self.problem.job(name).location
-                for robot in a.robots:
-                    free, there = robot_free.get(robot, (Fraction(0), None))
-                    travel = Fraction(0) if there is None else self.problem.travel(
-                        robot, there, here)
-                    start = max(start, free + travel)
-                end = start + self._planned_length(name)
+                start = self.due_start(name)
+                if start is None:
+                    arrivals = [self._arrival(robot, ready[robot], name, robot in first)
+                                for robot in a.robots]
+                    befores = [self._end_of(before, ends)
+                               for before in self.problem.predecessors(name)]
+                    start = max([now] + arrivals + befores)
+                end = max(Fraction(start), a.start) + self._planned_length(name)
             ends[name] = end
             for robot in a.robots:
-                robot_free[robot] = (end, self.problem.job(name).location)
+                ready[robot] = (end, here)
+                if record.end is None:
+                    first.discard(robot)
         return ends
+
+    def _end_of(self, job: str, projected: dict[str, Fraction]) -> Fraction:
+        """A predecessor's end: projected, or as the plan has it until it is, or as it was
+        done before the plan; 0 for a job added but not planned yet (it holds nothing up
+        that the plan knows of)."""
+        if job in projected:
+            return projected[job]
+        if job in self.plan.jobs:
+            return self.plan.jobs[job].end
+        end = self.jobs[job].end
+        return Fraction(0) if end is None else Fraction(end)
+
+    def _robots_free(self) -> dict[str, tuple[Fraction, str | None]]:
+        """When and where each robot is free for the first job the plan gives it: after the
+        last job it completed, and not before its release time; where it reported being,
+        else where that job or the mission placed it."""
+        free = {name: self.problem.robot(name).release_time for name in self.robots}
+        for name in self.done:
+            a = self.jobs[name].done_as
+            for robot in a.robots if a is not None else ():
+                free[robot] = max(free[robot], Fraction(self.jobs[name].end))
+        return {name: (free[name], r.location or self._last_place(name))
+                for name, r in self.robots.items()}
+
+    def _arrival(self, robot: str, ready: tuple[Fraction, str | None], job: str,
+                 first: bool) -> Fraction:
+        """When `robot` gets to `job`: as it reported, or leaving when and where `ready`
+        says. On its way to its first job of the plan not done, it arrives no earlier than
+        the leg under way ends, going on from there."""
+        record = self.jobs[job]
+        if robot in record.arrived:
+            return Fraction(record.arrived[robot])
+        here = self.problem.job(job).location
+        free, there = ready
+        arrival = free + (Fraction(0) if there is None
+                          else self.problem.travel(robot, there, here))
+        state = self.robots[robot]
+        if first and state.mode == RobotMode.TRAVELLING and state.destination \
+                and math.isfinite(state.busy_until):
+            arrival = max(arrival, Fraction(state.busy_until)
+                          + self.problem.travel(robot, state.destination, here))
+        return arrival
 
     def _reported_end(self, job: str) -> Fraction:
         """The latest end its working robots expect for their operations (0: none said)."""
@@ -448,8 +503,8 @@ class MissionTracker:
                           Fraction(record.start) + self._planned_length(name))
             expected = self._reported_end(name)
             if expected - planned > threshold:
-                late.append(f"job '{name}' is expected to end at {float(expected):.2f}, "
-                            f'{float(expected - planned):.2f} after its plan')
+                late.append(f"job '{name}' is expected to end at {decimal(expected)}, "
+                            f'{decimal(expected - planned)} after its plan')
         return late
 
     def executed_schedule(self) -> Schedule:

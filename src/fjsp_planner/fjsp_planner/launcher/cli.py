@@ -10,6 +10,7 @@ from pathlib import Path
 
 from fjsp_common.auth import KEY_FILE_VARIABLE
 from fjsp_common.contract import LATCHED_QOS, MISSION_STATUS_TOPIC
+from fjsp_common.decimals import decimals
 from fjsp_msgs.msg import MissionStatus
 from fjsp_planner.launcher.listener import Listener
 from fjsp_planner.launcher.supervision import (
@@ -21,6 +22,7 @@ from fjsp_planner.launcher.supervision import (
     Fleet,
     FleetError,
 )
+from fjsp_planner.model.scenario import scenario_warnings
 from fjsp_planner.workspace import default_out_dir
 
 
@@ -109,6 +111,8 @@ def run(args: argparse.Namespace) -> int:
     """The mission's exit code, once it has ended."""
     previous = {sig: signal.signal(sig, _stop_signal) for sig in (signal.SIGINT, signal.SIGTERM)}
     try:
+        for warning in scenario_warnings(fleet.problem):
+            print(f'fleet: warning: {warning}', file=sys.stderr, flush=True)
         fleet.start(stream_monitor=True, recorder=not args.no_recording)
         robots = ', '.join(r.name for r in fleet.problem.robots)
         print(f"fleet: scenario '{fleet.problem.name}' ({fleet.scenario}): planner, agents "
@@ -172,8 +176,8 @@ def _ended(status: MissionStatus) -> int | None:
     mission = status.mission_id or status.scenario_id
     if status.state == MissionStatus.STATE_COMPLETE:
         print(f"fleet: mission '{mission}' complete: {status.jobs_done}/{status.jobs_total} "
-              f'jobs done, makespan {status.projected_makespan:.2f} (planned '
-              f'{status.planned_makespan:.2f}) schedule units', flush=True)
+              'jobs done, makespan {} (planned {}) schedule units'.format(
+                  *decimals(status.projected_makespan, status.planned_makespan)), flush=True)
         return 0
     if status.state in (MissionStatus.STATE_FAILED, MissionStatus.STATE_CANCELLED):
         word = 'failed' if status.state == MissionStatus.STATE_FAILED else 'was cancelled'

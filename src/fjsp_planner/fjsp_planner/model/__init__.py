@@ -7,5 +7,6 @@
 - `limits`: how large and how extreme an input may be, checked before anything is built;
 - `schedule`: `Schedule` (exact times) and the solver-neutral `Result`;
 - `validate`: the independent check every schedule goes through; it shares no code with the
-  solvers.
+  solvers. Its messages (`Violation`) read in decimals (`fjsp_common.decimals`) and keep
+  the exact times.
 """

@@ -17,6 +17,7 @@ import stat
 from fractions import Fraction
 from pathlib import Path
 
+from fjsp_common.decimals import decimal
 from fjsp_planner.model.problem import ProblemError
 
 MAX_TIME = Fraction(10**6)
@@ -176,7 +177,7 @@ def scale_problems(robots, robot_types, jobs, distances, locomote, time_override
         travel = farthest * efficiency / robot.speed
         if travel > MAX_TIME:
             problems.append(f"robot '{robot.name}': travelling {where} would take "
-                            f'{float(travel):g} units (distance {float(farthest):g} x locomote '
+                            f'{decimal(travel)} units (distance {float(farthest):g} x locomote '
                             f'efficiency {float(efficiency):g} / speed {float(robot.speed):g}), '
                             f'more than the limit of {_g(MAX_TIME)}')
     return problems

@@ -4,10 +4,13 @@ Times are exact `Fraction`s: travel times such as distance * 10/3 must not be ro
 before a solver decides how to put them on its own grid.
 """
 
+import difflib
 from collections import Counter
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from fractions import Fraction
+
+from fjsp_common.decimals import decimal, decimals
 
 
 class ProblemError(ValueError):
@@ -16,6 +19,17 @@ class ProblemError(ValueError):
     def __init__(self, problems):
         self.problems = list(problems)
         super().__init__('\n'.join(self.problems))
+
+
+def suggestion(word, names: Iterable) -> str:
+    """`; did you mean 'X'?` naming the one of `names` closest to a misspelt `word`, or ''
+    when none is close."""
+    if not isinstance(word, str):
+        return ''
+    # Compared regardless of case: 'r1' is a slip for 'R1' whatever difflib's ratio says.
+    by_lower = {n.lower(): n for n in names if isinstance(n, str)}
+    close = difflib.get_close_matches(word.lower(), by_lower, n=1)
+    return f"; did you mean '{by_lower[close[0]]}'?" if close else ''
 
 
 @dataclass(frozen=True)
@@ -161,7 +175,7 @@ def _structural_problems(p: Problem) -> list[str]:
             if q not in p.operation_types:
                 problems.append(f"robot type '{type_name}': unknown operation type {q}")
             elif time < 0:
-                problems.append(f"robot type '{type_name}': negative time {time} for "
+                problems.append(f"robot type '{type_name}': negative time {decimal(time)} for "
                                 f'operation type {p.operation_label(q)}')
         if p.locomote in p.operation_types and p.locomote not in efficiency:
             problems.append(f"robot type '{type_name}' has no efficiency for the locomote "
@@ -169,19 +183,23 @@ def _structural_problems(p: Problem) -> list[str]:
                             'travel')
     for r in p.robots:
         if r.type not in p.robot_types:
-            problems.append(f"robot '{r.name}': unknown robot type '{r.type}'")
+            problems.append(f"robot '{r.name}': unknown robot type '{r.type}'"
+                            + suggestion(r.type, p.robot_types))
         if r.speed <= 0:
-            problems.append(f"robot '{r.name}': speed must be positive, got {r.speed}")
+            problems.append(f"robot '{r.name}': speed must be positive, got "
+                            f'{decimal(r.speed)}')
         if r.release_time < 0:
-            problems.append(f"robot '{r.name}': negative release time {r.release_time}")
+            problems.append(f"robot '{r.name}': negative release time "
+                            f'{decimal(r.release_time)}')
     for (robot, q), time in p.time_overrides.items():
         if robot not in robots:
-            problems.append(f"time override names unknown robot '{robot}'")
+            problems.append(f"time override names unknown robot '{robot}'"
+                            + suggestion(robot, robots))
         if q not in p.operation_types:
             problems.append(f"time override for '{robot}' names unknown operation type {q}")
         if time < 0:
             problems.append(f"time override for '{robot}', operation type "
-                            f'{p.operation_label(q)}: negative time {time}')
+                            f'{p.operation_label(q)}: negative time {decimal(time)}')
     for j in p.jobs:
         if not j.plans:
             problems.append(f"job '{j.name}' has no process plan")
@@ -194,18 +212,19 @@ def _structural_problems(p: Problem) -> list[str]:
                                     f'type {q}')
     for (a, b), d in p.distances.items():
         if d < 0:
-            problems.append(f"distance '{a}'-'{b}' is negative ({d})")
+            problems.append(f"distance '{a}'-'{b}' is negative ({decimal(d)})")
     if p.locomote in p.operation_types:
         problems.extend(_missing_distances(p))
     for a, b in p.precedence:
         for name in (a, b):
             if name not in jobs:
-                problems.append(f"precedence arc ('{a}', '{b}') names unknown job '{name}'")
+                problems.append(f"precedence arc ('{a}', '{b}') names unknown job '{name}'"
+                                + suggestion(name, jobs))
     for a, b, q in p.holding:
         arc = _holding_label(p, a, b, q)
         for name in (a, b):
             if name not in jobs:
-                problems.append(f"{arc} names unknown job '{name}'")
+                problems.append(f"{arc} names unknown job '{name}'" + suggestion(name, jobs))
         if q not in p.operation_types:
             problems.append(f'{arc}: unknown operation type {q}')
     sizes = {len(panel) for panel in p.panels}
@@ -227,18 +246,47 @@ def _structural_problems(p: Problem) -> list[str]:
 
 
 def _missing_distances(p: Problem) -> list[str]:
-    locations = {j.location for j in p.jobs}
-    locations.update(r.start_location for r in p.robots if r.start_location)
-    ordered = sorted(locations)
-    missing = []
-    for i, a in enumerate(ordered):
-        for b in ordered[i + 1:]:
+    """Every two places robots may travel between need a distance. A place in no distance at
+    all is named once, with whatever is there, rather than once per other place: a misspelt
+    name, or a start location the table forgot."""
+    ordered = p.locations()
+    if len(ordered) < 2:
+        return []
+    if not p.distances:
+        return [f'no distances are given, but robots travel (operation type '
+                f'{p.operation_label(p.locomote)}) between {len(ordered)} locations: '
+                "'distances' must give one between every two of them"]
+    named = {a for a, _ in p.distances} | {b for _, b in p.distances}
+    unused = named - set(ordered)
+    missing = [f"location '{place}' ({_there(p, place)}) has no distance to any other "
+               'location' + suggestion(place, unused or named)
+               for place in ordered if place not in named]
+    placed = [place for place in ordered if place in named]
+    for i, a in enumerate(placed):
+        for b in placed[i + 1:]:
             if (a, b) not in p.distances or (b, a) not in p.distances:
                 missing.append(f"no distance between locations '{a}' and '{b}'")
             elif p.distances[(a, b)] != p.distances[(b, a)]:
-                missing.append(f"distance '{a}'-'{b}' is not symmetric: "
-                               f'{p.distances[(a, b)]} vs {p.distances[(b, a)]}')
+                missing.append("distance '{}'-'{}' is not symmetric: {} vs {}".format(
+                    a, b, *decimals(p.distances[(a, b)], p.distances[(b, a)])))
     return missing
+
+
+def _there(p: Problem, place: str) -> str:
+    """What is at `place`: `jobs 'A', 'B'; start of robot 'R1'`."""
+    parts = []
+    for one, many, names in (('job', 'jobs', [j.name for j in p.jobs if j.location == place]),
+                             ('start of robot', 'start of robots',
+                              [r.name for r in p.robots if r.start_location == place])):
+        if names:
+            parts.append(f'{one if len(names) == 1 else many} {listed(names)}')
+    return '; '.join(parts)
+
+
+def listed(names, most: int = 3) -> str:
+    """`'A', 'B', 'C' and 2 more`: names for a message, the first `most` of them."""
+    more = f' and {len(names) - most} more' if len(names) > most else ''
+    return ', '.join(f"'{n}'" for n in names[:most]) + more
 
 
 def _cycle_problems(p: Problem) -> list[str]:
@@ -315,13 +363,26 @@ def _staffing_problems(p: Problem) -> list[str]:
         for index, plan in enumerate(job.plans):
             staffed = max_staffed(p, plan, robots)
             if staffed < len(plan):
-                shortfalls.append(f'plan {index} {p.plan_label(plan)} needs {len(plan)} '
-                                  f'distinct robots able to do its operations; {staffed} '
-                                  'can')
+                shortfalls.append(f'plan {index} {p.plan_label(plan)} needs '
+                                  f'{robots_needed(len(plan))}; {how_many_can(staffed)}')
         if len(shortfalls) == len(job.plans):
             problems.append(f"job '{job.name}' cannot be staffed: " + '; '.join(shortfalls)
                             + besides)
     return problems
+
+
+def robots_needed(count: int, work: str = '') -> str:
+    """`a robot able to do it`, `3 distinct robots able to do its operations`; `work` names
+    what they must do instead."""
+    if count == 1:
+        return f"a robot able to do {work or 'it'}"
+    return f"{count} distinct robots able to do {work or 'its operations'}"
+
+
+def how_many_can(count: int, which: str = '') -> str:
+    """`no robot can`, `2 can`; `which` qualifies them (`healthy`)."""
+    who = f'{which} ' if which else ''
+    return f'no {who}robot can' if count == 0 else f'{count} {who}can'
 
 
 def max_staffed(p: Problem, plan, robots) -> int:

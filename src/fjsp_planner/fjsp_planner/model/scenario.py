@@ -8,15 +8,15 @@ that cannot be read is kept in a neutral form where it can be, so that it is rep
 rather than once more by every arc that names it.
 """
 
-import difflib
 from fractions import Fraction
 from pathlib import Path
 
 import yaml
 
+from fjsp_common.decimals import decimals
 from fjsp_planner.model import limits
 from fjsp_planner.model.limits import MAX_TIME, shown
-from fjsp_planner.model.problem import Job, Problem, ProblemError, Robot
+from fjsp_planner.model.problem import Job, Problem, ProblemError, Robot, listed, suggestion
 
 DEFAULT_SHIFT = Fraction(60)
 
@@ -211,10 +211,8 @@ class _Reader:
         for key in entry:
             if key in allowed:
                 continue
-            close = difflib.get_close_matches(str(key), allowed, n=1)
-            hint = f"; did you mean '{close[0]}'?" if close else ''
             self.problems.append(f'{what}: unknown key {shown(key)} (allowed: '
-                                 f'{", ".join(allowed)}){hint}')
+                                 f'{", ".join(allowed)})' + suggestion(str(key), allowed))
 
     def mapping(self, data, key, what, required=True, limit=None):
         value = data.get(key)
@@ -271,7 +269,8 @@ def _from_mapping(data, default_name, panels=None, shift=None):
             return ref
         if isinstance(ref, str) and ref in by_name:
             return by_name[ref]
-        read.problems.append(f'{what}: unknown operation type {shown(ref)}')
+        read.problems.append(f'{what}: unknown operation type {shown(ref)}'
+                             + suggestion(ref, by_name))
         if item is not None:
             read.explained(item)
         return None
@@ -497,9 +496,32 @@ def _distance(read, distances, a, b, value, symmetric):
         return
     for key in ((a, b), (b, a)) if symmetric else ((a, b),):
         if symmetric and key in distances and distances[key] != value:
-            read.problems.append(f"distance '{a}'-'{b}' is given twice: "
-                                 f'{distances[key]} and {value}')
+            read.problems.append("distance '{}'-'{}' is given twice: {} and {}".format(
+                a, b, *decimals(distances[key], value)))
         distances[key] = value
+
+
+def scenario_warnings(problem: Problem) -> list[str]:
+    """What a scenario says that probably does not mean what its author meant, though it is a
+    valid problem: each names the items and what to write instead. Printed by `fjsp-solve`
+    and logged by the planner and the launcher, never refused."""
+    warnings = []
+    placed = [r.name for r in problem.robots if r.start_location]
+    if problem.locomote is None and (problem.distances or placed):
+        given = [what for what, there in (
+            ('distances', problem.distances),
+            (f"the start location{'s' if len(placed) > 1 else ''} of "
+             f"robot{'s' if len(placed) > 1 else ''} {listed(placed)}", placed)) if there]
+        # The travel type is an operation type robot types have a time for but no job uses.
+        used = {q for job in problem.jobs for plan in job.plans for q in plan}
+        travel = [name for q, name in problem.operation_types.items() if q not in used
+                  and any(q in times for times in problem.robot_types.values())]
+        hint = (f"; did you mean 'locomote: {travel[0]}'?" if len(travel) == 1 else
+                "; name it with 'locomote: <operation type>', or call it 'locomote'")
+        warnings.append(' and '.join(given) + ' are given, but no operation type is the '
+                        "travel type (none is called 'locomote', and no 'locomote:' names "
+                        f'one): travel takes no time{hint}')
+    return warnings
 
 
 def problem_mapping(problem: Problem) -> dict:

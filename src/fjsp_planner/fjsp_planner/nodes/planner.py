@@ -49,6 +49,7 @@ from fjsp_common.contract import (
     publisher,
     subscription,
 )
+from fjsp_common.decimals import decimal, decimals
 from fjsp_common.diagnostics import diagnostic_array, planner_diagnostic
 from fjsp_common.fleet import DIAGNOSTICS_PERIOD, PLANNER_NODE
 from fjsp_common.running import ParameterError, declare, run_node, shorten
@@ -81,7 +82,7 @@ from fjsp_planner.execution.replan import improve, repair
 from fjsp_planner.execution.tracking import Ignored
 from fjsp_planner.model.extension import extend
 from fjsp_planner.model.problem import ProblemError
-from fjsp_planner.model.scenario import load_scenario, scenario_from_text
+from fjsp_planner.model.scenario import load_scenario, scenario_from_text, scenario_warnings
 from fjsp_planner.nodes.conversions import cancel_msg, job_states, plan_msg
 from fjsp_planner.solving.solve import solve
 
@@ -256,6 +257,8 @@ class PlannerNode(Node):
             self.journal.write(MissionRecord(
                 mission_id, text, name, panels, shift, origin, settings.__dict__, self.wall()))
         self.get_logger().info(f"mission '{mission_id}' accepted")
+        for warning in scenario_warnings(problem):
+            self.get_logger().warning(f'scenario {problem.name!r}: {warning}')
         self.carry_out(effects)
         return mission_id
 
@@ -427,8 +430,8 @@ class PlannerNode(Node):
             planned_makespan=view.planned_makespan, revisions=view.revision,
             jobs_done=view.jobs_done, jobs_total=view.jobs_total,
             reasons=list(view.blocked) if not complete else
-            [f'executed makespan {view.projected_makespan:.2f}, planned '
-             f'{view.planned_makespan:.2f}'])
+            ['executed makespan {}, planned {}'.format(
+                *decimals(view.projected_makespan, view.planned_makespan))])
 
     def cancel_goal(self, handle) -> CancelResponse:
         if self.goal is None or self.goal.handle.goal_id != handle.goal_id:
@@ -587,7 +590,7 @@ class PlannerNode(Node):
         elif request.kind == SolveKind.REPAIR:
             self.replan_began = time.monotonic()
             now_units = self.controller.now_units(self.wall())
-            self.get_logger().warning(f're-planning at t={now_units:.2f}: '
+            self.get_logger().warning(f're-planning at t={decimal(now_units)}: '
                                       + shorten('; '.join(request.reasons), 2000))
             future = self.pool.submit(repair, request.problem, request.previous,
                                       request.state, time_limit=request.time_limit)
@@ -681,10 +684,10 @@ class PlannerNode(Node):
         gap = f', gap {result.gap:.1%}' if result.gap is not None else ''
         now_units = self.controller.now_units(self.wall())
         log.info(f'published plan revision {effect.revision}: makespan '
-                 f'{float(result.makespan):g} ({result.status}{gap}, '
+                 f'{decimal(result.makespan)} ({result.status}{gap}, '
                  f'{result.solve_seconds:.2f} s)'
                  + (f'; mission starts in {self.start_delay:g} s at {self.time_scale:g} s '
-                    'per unit' if effect.revision == 1 else f' at t={now_units:.2f}'))
+                    'per unit' if effect.revision == 1 else f' at t={decimal(now_units)}'))
         for robot_plan in msg.robots:
             log.info(f'  {robot_plan.robot}: '
                      + (' -> '.join(t.job for t in robot_plan.tasks) or 'no task'))
@@ -712,7 +715,7 @@ class PlannerNode(Node):
             self.journal.write(DoneRecord(effect.assignment, effect.revision, event_id))
         self.publish_done_event(event_id, mission.id, effect.job, effect.revision, effect.time)
         tracker = mission.tracker
-        self.get_logger().info(f'job {effect.job} done at t={effect.time:.2f} '
+        self.get_logger().info(f'job {effect.job} done at t={decimal(effect.time)} '
                                f'({len(tracker.done)}/{len(tracker.jobs)})')
 
     def publish_done_event(self, event_id: str, mission_id: str, job: str, revision: int,

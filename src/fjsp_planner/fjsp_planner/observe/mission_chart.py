@@ -19,6 +19,7 @@ import matplotlib.pyplot as plt  # noqa: E402  (the backend must be chosen first
 from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.patches import Patch  # noqa: E402
 
+from fjsp_common.decimals import decimal, decimals  # noqa: E402
 from fjsp_planner.observe import views  # noqa: E402
 from fjsp_planner.observe.chart_layout import DPI, BarLabels, Drawn, chart_width, saved  # noqa: E402
 from fjsp_planner.observe.history import FleetHistory, MissionHistory  # noqa: E402
@@ -52,7 +53,7 @@ def draw_mission(timeline: dict, header: dict, path: Path) -> Drawn:
     now_units = timeline['now']
     colour = job_colours([w['job'] for w in timeline['work']]
                          + [t['job'] for p in timeline['plans'] for t in p['tasks']])
-    notes = [f"r{r['number']} at t={r['time']:.1f}: "
+    notes = [f"r{r['number']} at t={decimal(r['time'])}: "
              + ('; '.join(r['reasons']) or 'no reason given')
              for r in timeline['revisions'] if r['number'] > 1 and r['time'] is not None]
     # Heights in inches: title, one per robot, axis and legend, a line per revision's reasons.
@@ -148,15 +149,11 @@ def write_mission(fleet: FleetHistory, mission: MissionHistory, wall: float, png
 def _title(h: dict) -> str:
     agree = '' if h['agrees'] or not h['status_jobs'] else \
         f" (planner says {h['status_jobs'][0]}/{h['status_jobs'][1]})"
-    executed = h['executed_makespan']
+    first, latest, executed = decimals(h['first_makespan'], h['planned_makespan'],
+                                       h['executed_makespan'])
     return (f"{h['scenario']} - mission {h['mission_id']}: {h['state']}, "
             f"{h['jobs_done']}/{h['jobs_total']} jobs done{agree}\nrevision {h['revision']}; "
-            f"makespan planned {_n(h['first_makespan'])} (r1), {_n(h['planned_makespan'])} "
-            f"(latest), executed {_n(executed)}")
-
-
-def _n(value) -> str:
-    return '-' if value is None else f'{value:.1f}'
+            f'makespan planned {first} (r1), {latest} (latest), executed {executed}')
 
 
 def _legend(plans: int) -> list:

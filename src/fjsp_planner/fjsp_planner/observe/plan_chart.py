@@ -9,6 +9,7 @@ import matplotlib
 matplotlib.use('Agg')
 import matplotlib.pyplot as plt  # noqa: E402  (the backend must be chosen first)
 
+from fjsp_common.decimals import decimal  # noqa: E402
 from fjsp_planner.model.problem import Problem  # noqa: E402
 from fjsp_planner.model.schedule import Schedule  # noqa: E402
 from fjsp_planner.observe.chart_layout import DPI, BarLabels, Drawn, chart_width, saved  # noqa: E402
@@ -47,7 +48,7 @@ def draw_gantt(problem: Problem, schedule: Schedule, path, title: str = '',
         style = '--' if label == 'planned' else ':'
         ax.axvline(float(timeline.makespan), color='red', linestyle=style)
         ax.text(float(timeline.makespan), len(robots) - 0.45,
-                f' {label} makespan {float(timeline.makespan):g}', color='red', fontsize=8)
+                f' {label} makespan {decimal(timeline.makespan)}', color='red', fontsize=8)
     ax.set_yticks(range(len(robots)), list(reversed(robots)))
     ax.set_xlabel('time (schedule units)')
     ax.set_xlim(left=0)

@@ -12,6 +12,7 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 
 from fjsp_common.clock import ScheduleClock
+from fjsp_common.decimals import decimal
 from fjsp_common.vocabulary import MissionEventKind, MissionState
 from fjsp_planner.observe.history import Counts, MissionHistory, Outcome
 
@@ -81,7 +82,7 @@ def _derived(mission: MissionHistory) -> list[StoryItem]:
     stamps = {p.revision: p.stamp for p in mission.plans.values()}
     for revision in mission.revisions():
         reasons = revision.reasons or (
-            (f'makespan {revision.makespan:g} ({revision.solver_status})',)
+            (f'makespan {decimal(revision.makespan)} ({revision.solver_status})',)
             if revision.number == 1 else ())
         items.append(StoryItem(revision.published, MissionEventKind.PLAN_PUBLISHED,
                                tell(MissionEventKind.PLAN_PUBLISHED, '', '', revision.number,

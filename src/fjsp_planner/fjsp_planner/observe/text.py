@@ -2,11 +2,8 @@
 notice changed, one line per event of the story, and the summary of an ended mission, so that
 a scroll-back of the monitor's output tells what happened and why."""
 
+from fjsp_common.decimals import decimal, decimals
 from fjsp_planner.observe.history import MissionHistory
-
-
-def _units(value) -> str:
-    return '?' if value is None else f'{value:.2f}'
 
 
 def frame(header: dict | None, rows: list[dict]) -> tuple[str, tuple]:
@@ -21,15 +18,16 @@ def frame(header: dict | None, rows: list[dict]) -> tuple[str, tuple]:
         lines = [
             f"mission {h['mission_id']} ({h['scenario']}), revision {h['revision']}: "
             f"{h['state']}, {h['jobs_done']}/{h['jobs_total']} jobs done, {h['jobs_running']} "
-            f"running; makespan planned {_units(h['planned_makespan'])}, projected "
-            f"{_units(h['projected_makespan'])}; t={_units(h['time'])}"]
+            'running; makespan planned {}, projected {}'.format(
+                *decimals(h['planned_makespan'], h['projected_makespan']))
+            + f"; t={decimal(h['time'])}"]
         if any(h['ignored']):
             stale, duplicate, unknown = h['ignored']
             lines[0] += f'; ignored {stale} stale, {duplicate} duplicate, {unknown} unknown'
         if h['revision'] > 1 and h['replan_reasons']:
             lines.append(f"  re-planned because: {'; '.join(h['replan_reasons'])}")
         lines += [f'  warning: {w}' for w in h['warnings']]
-        lines += [f'  blocked: {b}' for b in h['blocked_reasons']]
+        lines += [f"  {h['reasons_label'].lower()}: {b}" for b in h['blocked_reasons']]
         key = (h['mission_id'], h['state'], h['revision'], h['jobs_done'], h['jobs_running'],
                h['jobs_total'], tuple(h['replan_reasons']), tuple(h['warnings']),
                tuple(h['blocked_reasons']), tuple(h['ignored']))
@@ -51,13 +49,12 @@ def robot_line(row: dict) -> str:
     if row['detail']:
         line += f"; {row['detail']}"
     elif not row['healthy'] and row['since'] is not None:
-        line += f"; since t={row['since']:.2f}"
+        line += f"; since t={decimal(row['since'])}"
     return line
 
 
 def story_line(item: dict) -> str:
-    time = item['time']
-    return f"t={time:8.2f}  {item['text']}" if time is not None else f"t=       ?  {item['text']}"
+    return f"t={decimal(item['time']):>8}  {item['text']}"
 
 
 def summary(mission: MissionHistory) -> str:
@@ -66,9 +63,10 @@ def summary(mission: MissionHistory) -> str:
     status = mission.status
     revisions = mission.revisions()
     state = status.state if status else 'unknown'
-    planned = ', '.join(f'{r.makespan:.2f} in revision {r.number}' for r in revisions
-                        if r.makespan == r.makespan)
-    executed = mission.executed_makespan()
+    shown = [r for r in revisions if r.makespan == r.makespan]
+    executed, *makespans = decimals(mission.executed_makespan(), *(r.makespan for r in shown))
+    planned = ', '.join(f'{m} in revision {r.number}' for m, r in zip(makespans, shown,
+                                                                     strict=True))
     text = (f'mission {mission.mission_id} ({mission.scenario_id}) {state}: '
             f'{counts.done}/{counts.total} jobs done')
     if status is not None:
@@ -76,7 +74,7 @@ def summary(mission: MissionHistory) -> str:
                  + ('' if mission.agrees_with_status() else ', DISAGREES') + ')')
     text += (f'; {len(revisions)} revision{"s" if len(revisions) != 1 else ""}, '
              f'{counts.aborted} aborted attempt{"s" if counts.aborted != 1 else ""}, '
-             f'{counts.voided} voided; makespan executed {_units(executed)}')
+             f'{counts.voided} voided; makespan executed {executed}')
     if planned:
         text += f', planned {planned}'
     return text

@@ -8,13 +8,19 @@ Times in them are schedule units.
 
 import math
 
+from fjsp_common.decimals import decimal
 from fjsp_common.revisions import void
-from fjsp_common.vocabulary import EventKind, RobotMode
+from fjsp_common.vocabulary import EventKind, MissionState, RobotMode
 from fjsp_planner.observe.history import FleetHistory, MissionHistory, Outcome
 from fjsp_planner.observe.story import story as told
 
 SHOWN_PLANS = 2
 """Planned lanes in the timeline: the first revision and the latest one."""
+
+REASONS_LABELS = {MissionState.FAILED: 'Failed', MissionState.CANCELLED: 'Cancelled',
+                  MissionState.WAITING_FOR_ROBOTS: 'Waiting'}
+"""What the status's `blocked_reasons` are, by mission state: why it failed, why it was
+cancelled, whom it waits for; in any other state, what blocks it."""
 
 
 def _number(value: float | None) -> float | None:
@@ -56,6 +62,7 @@ def header(mission: MissionHistory, wall: float) -> dict:
                                else last.reasons if last else ()),
         'warnings': list(s.warnings) if s else [],
         'blocked_reasons': list(s.blocked_reasons) if s else [],
+        'reasons_label': REASONS_LABELS.get(s.state, 'Blocked') if s else 'Blocked',
         'ignored': list(s.ignored) if s else [0, 0, 0],
     }
 
@@ -125,7 +132,7 @@ def _detail(mission: MissionHistory, state, mode: RobotMode) -> str:
     planned = {t.job for t in mission.plans[state.revision].tasks}
     waits = [f'{r} to arrive' for r in mine.co_workers if r not in arrived]
     waits += [f'{j} to be done' for j in mine.predecessors if j in planned and j not in done]
-    start = f', planned start t={mine.start:.1f}'
+    start = f', planned start t={decimal(mine.start)}'
     return (f'{job}: waits for {", ".join(waits)}{start}{holding}' if waits
             else f'{job}: starting{holding}')
 

@@ -5,6 +5,7 @@ import threading
 import time
 from fractions import Fraction
 
+from fjsp_common.decimals import decimal
 from fjsp_planner.model.limits import MAX_WORKERS
 from fjsp_planner.model.problem import Problem
 from fjsp_planner.model.schedule import Result, Schedule, Status
@@ -269,7 +270,7 @@ def _with_panel_bounds(problem: Problem, result: Result, found_before: Fraction 
     return dataclasses.replace(
         result, lower_bound=raised,
         status=Status.OPTIMAL if raised >= best else result.status,
-        notes=result.notes + (f'bound raised to {float(raised):g} by panel decomposition',))
+        notes=result.notes + (f'bound raised to {decimal(raised)} by panel decomposition',))
 
 
 def _count_from(problem: Problem, result: Result, setup: float) -> Result:

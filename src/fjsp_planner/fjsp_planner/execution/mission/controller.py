@@ -21,6 +21,7 @@ from dataclasses import dataclass, field, replace
 from fractions import Fraction
 
 from fjsp_common.clock import ScheduleClock
+from fjsp_common.decimals import decimal, decimals
 from fjsp_common.vocabulary import EventKind, MissionEventKind, MissionState, RobotMode
 from fjsp_planner.execution.journal import Record
 from fjsp_planner.execution.mission import continuation
@@ -614,12 +615,12 @@ class MissionController:
                                                    progressed, continued):
             # The robots got further than the search kept: the plan cannot be followed.
             dropped = Note(MissionEventKind.WARNING, (
-                f'a better plan (makespan {float(better.result.makespan):.2f}) dropped: '
+                f'a better plan (makespan {decimal(better.result.makespan)}) dropped: '
                 + ', '.join(f"job '{j}'" for j in progressed)
                 + ' progressed while it was searched for',))
             return [dropped] + self._search_longer(mission, solving, solving.published, wall)
-        reason = (f'a better plan: makespan {mission.planned_makespan:.2f} -> '
-                  f'{float(better.result.makespan):.2f}')
+        reason = 'a better plan: makespan {} -> {}'.format(
+            *decimals(mission.planned_makespan, better.result.makespan))
         continued |= frozenset(progressed)
         continued |= continuation.unchanged(mission.tracker, better.schedule, continued)
         published = self._publish(mission, better.residual.problem, better.result, continued,
@@ -721,10 +722,10 @@ class MissionController:
         mission.enter(MissionState.COMPLETE)
         # A mission blocked for want of robots can still complete on the plan it had.
         mission.blocked, mission.blocked_since = (), None
-        executed = float(mission.tracker.projected_makespan(0))
+        executed = mission.tracker.projected_makespan(0)
         return [Note(MissionEventKind.MISSION_COMPLETE,
-                     (f'executed makespan {executed:.2f}, planned '
-                      f'{mission.planned_makespan:.2f}',))]
+                     ('executed makespan {}, planned {}'.format(
+                         *decimals(executed, mission.planned_makespan)),))]
 
     # --- views -----------------------------------------------------------------------------
 

@@ -18,8 +18,19 @@ const SVG = 'http://www.w3.org/2000/svg';
 
 function $(id) { return document.getElementById(id); }
 
-function number(value, digits = 1) {
-  return value === null || value === undefined ? '-' : value.toFixed(digits);
+// Times as everywhere a person reads them: an integer as it is, any other time with three
+// decimals, more (up to the data's six) where two times written together would read the same.
+function numbers(...values) {
+  const known = values.filter((v) => v !== null && v !== undefined);
+  let places = 3;
+  const alike = (a, b) => a !== b && a.toFixed(places) === b.toFixed(places);
+  while (places < 6 && known.some((a) => known.some((b) => alike(a, b)))) places += 1;
+  return values.map((v) => (v === null || v === undefined ? '-'
+    : Number.isInteger(v) ? String(v) : v.toFixed(places)));
+}
+
+function number(value) {
+  return numbers(value)[0];
 }
 
 function element(tag, attributes = {}, text = '') {
@@ -59,10 +70,11 @@ function renderMission() {
   if (m.status_jobs && !m.agrees) detail.push(`planner says ${m.status_jobs[0]}/${m.status_jobs[1]}`);
   $('jobs-detail').textContent = detail.join(', ');
   $('time').textContent = number(m.time);
-  const parts = [`planned ${number(m.planned_makespan)}`];
-  if (m.revision > 1) parts.push(`(revision 1: ${number(m.first_makespan)})`);
-  if (m.ended) parts.push(`executed ${number(m.executed_makespan)}`);
-  else parts.push(`projected ${number(m.projected_makespan)}`);
+  const [planned, first, outcome] = numbers(m.planned_makespan, m.first_makespan,
+    m.ended ? m.executed_makespan : m.projected_makespan);
+  const parts = [`planned ${planned}`];
+  if (m.revision > 1) parts.push(`(revision 1: ${first})`);
+  parts.push(m.ended ? `executed ${outcome}` : `projected ${outcome}`);
   $('makespan').textContent = parts.join(', ');
   const reasons = $('reasons');
   reasons.replaceChildren();
@@ -71,7 +83,7 @@ function renderMission() {
       `Revision ${m.revision} re-planned because: ${m.replan_reasons.join('; ')}`));
   }
   for (const w of m.warnings) reasons.appendChild(element('div', {class: 'warning'}, `Warning: ${w}`));
-  for (const b of m.blocked_reasons) reasons.appendChild(element('div', {class: 'blocked'}, `Blocked: ${b}`));
+  for (const b of m.blocked_reasons) reasons.appendChild(element('div', {class: 'blocked'}, `${m.reasons_label}: ${b}`));
 }
 
 function renderRobots() {
@@ -226,7 +238,7 @@ function renderStory() {
   for (const item of [...(data.story || [])].reverse()) {
     if (!(item.key in window.fjspShown)) window.fjspShown[item.key] = now;
     const line = element('li', {'data-kind': item.kind, 'data-key': item.key});
-    line.appendChild(element('span', {class: 't'}, `t=${number(item.time, 2)}`));
+    line.appendChild(element('span', {class: 't'}, `t=${number(item.time)}`));
     line.appendChild(document.createTextNode(item.text));
     list.appendChild(line);
   }
