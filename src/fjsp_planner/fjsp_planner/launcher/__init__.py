@@ -5,6 +5,8 @@
 - `params`: the user's ROS parameters file and the per-node files the launcher writes;
 - `listener`: a private rclpy node on a thread of its own, through which the launcher (and
   the test harness) hears the fleet's topics;
+- `status`: which mission statuses the launcher believes: signed by its planner, about the
+  mission that planner runs;
 - `cli`: `ros2 run fjsp_planner fleet`, which judges the mission from `mission_status` and
   exits with its outcome;
 - `hosts`: simulated hosts on network namespaces, for running a fleet across real links.

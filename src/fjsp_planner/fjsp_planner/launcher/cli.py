@@ -1,5 +1,6 @@
 """`ros2 run fjsp_planner fleet`: a scenario run on the node network from the command line,
-until Ctrl-C or the end of the mission, its outcome as the exit code."""
+until Ctrl-C or the end of the mission, its outcome as the exit code. It believes only the
+mission statuses its planner signed (`launcher.status`)."""
 
 import argparse
 import math
@@ -8,11 +9,12 @@ import sys
 import time
 from pathlib import Path
 
-from fjsp_common.auth import KEY_FILE_VARIABLE
-from fjsp_common.contract import LATCHED_QOS, MISSION_STATUS_TOPIC
+from fjsp_common.auth import KEY_FILE_VARIABLE, read_key
+from fjsp_common.contract import MISSION_STATUS
 from fjsp_common.decimals import decimals
 from fjsp_msgs.msg import MissionStatus
 from fjsp_planner.launcher.listener import Listener
+from fjsp_planner.launcher.status import MissionWatch
 from fjsp_planner.launcher.supervision import (
     DEFAULT_TIME_SCALE,
     EXIT_BAD_INPUT,
@@ -105,8 +107,13 @@ def run(args: argparse.Namespace) -> int:
     except RuntimeError as error:  # rclpy's RCLError, e.g. a bad ROS_DOMAIN_ID
         print(f'fleet: could not start ROS: {error}', file=sys.stderr)
         return EXIT_FAILED
-    latest: list[MissionStatus] = []
-    watch.subscribe(MissionStatus, MISSION_STATUS_TOPIC, LATCHED_QOS, latest.append)
+    statuses = MissionWatch(read_key(fleet.key_file) if fleet.key_file else None,
+                            watch.node.resolve_topic_name(MISSION_STATUS.name))
+
+    def receive(msg):
+        if warning := statuses.receive(msg):
+            print(f'fleet: {warning}', file=sys.stderr, flush=True)
+    watch.subscribe(MISSION_STATUS.type, MISSION_STATUS.name, MISSION_STATUS.qos, receive)
     ended: list[int] = []
     """The mission's exit code, once it has ended."""
     previous = {sig: signal.signal(sig, _stop_signal) for sig in (signal.SIGINT, signal.SIGTERM)}
@@ -120,12 +127,16 @@ def run(args: argparse.Namespace) -> int:
         if fleet.key_file is not None:
             print(f'fleet: authenticated with the key in {fleet.key_file}; tools need it too: '
                   f'export {KEY_FILE_VARIABLE}={fleet.key_file}', flush=True)
-        return _watch(fleet, latest, ended, args)
+        else:
+            print('fleet: unauthenticated (--unauthenticated): any node on this ROS domain can '
+                  'publish mission statuses this launcher believes, and plans the robots '
+                  'follow', flush=True)
+        return _watch(fleet, statuses, ended, args)
     except _SignalError as stopped:
         if ended:
             return ended[0]
         print(f'fleet: stopped by {stopped} before the mission ended '
-              f'({_summary(latest[-1] if latest else None)})', file=sys.stderr)
+              f'({_summary(statuses.latest)})', file=sys.stderr)
         return stopped.code
     finally:
         # Stopping is bounded (SIGKILL after the grace period); a second Ctrl-C must not
@@ -134,18 +145,20 @@ def run(args: argparse.Namespace) -> int:
             signal.signal(sig, signal.SIG_IGN)
         fleet.stop()
         watch.close()
+        if tally := statuses.tally():
+            print(f'fleet: {tally}', file=sys.stderr)
         for sig, handler in previous.items():
             signal.signal(sig, handler)
 
 
-def _watch(fleet: Fleet, latest: list, ended: list, args) -> int:
+def _watch(fleet: Fleet, statuses: MissionWatch, ended: list, args) -> int:
     """Until the outcome is decided: the exit code, its reason printed. Without
     --exit-on-complete only a node's death or the timeout decides; Ctrl-C ends it."""
     began = time.monotonic()
     ended_at = None
     while True:
         time.sleep(0.1)
-        status = latest[-1] if latest else None
+        status = statuses.latest
         if not ended and status is not None:
             code = _ended(status)
             if code is not None:
