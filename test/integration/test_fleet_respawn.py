@@ -1,9 +1,12 @@
 """`ros2 run fjsp_planner fleet` keeps its fleet up: a node killed mid-mission is started
 again and the mission completes, each job done once — an agent (re-planned around and back),
-the planner (resumed from its journal). With --no-respawn a killed node ends the fleet, as
-before."""
+the monitor (back on its web port), the planner (resumed from its journal). With
+--no-respawn a killed node ends the fleet, as before."""
 
 import subprocess
+import time
+import urllib.error
+import urllib.request
 from contextlib import contextmanager
 
 import pytest
@@ -12,6 +15,7 @@ from fjsp_msgs.msg import MissionEvent, MissionStatus
 from fjsp_planner.model.scenario import load_scenario
 from fjsp_planner.testing import Observer, check_jobs_done_once, check_nothing_redone
 
+from browser import free_port
 from fleet_command import children, launcher, node_pid, still_running, wait_for_nodes
 from repo_paths import PAPER
 
@@ -67,7 +71,7 @@ def check_each_job_done_once(observer: Observer) -> None:
 
 
 def test_a_killed_agent_comes_back_and_the_mission_completes(tmp_path, ros_domain):
-    with paper_fleet(tmp_path, ros_domain) as (fleet, observer):
+    with paper_fleet(tmp_path, ros_domain, '--web-port', '0') as (fleet, observer):
         under_way(observer)
         kill(fleet, "robot_name:='MARC1'")
         out, err = finish(fleet)
@@ -82,8 +86,36 @@ def test_a_killed_agent_comes_back_and_the_mission_completes(tmp_path, ros_domai
     assert log.count('authenticated fleet') == 2  # both agents logged to it
 
 
+def test_a_killed_monitor_comes_back_on_its_web_port(tmp_path, ros_domain):
+    port = free_port()
+    with paper_fleet(tmp_path, ros_domain, '--web-port', str(port)) as (fleet, observer):
+        under_way(observer, jobs=1)
+        assert page_answers(port, 10)
+        kill(fleet, 'monitor_node')
+        assert page_answers(port, 30)
+        out, err = finish(fleet)
+    assert f'live mission page: http://127.0.0.1:{port}/' in out
+    assert "node 'monitor' killed by SIGKILL; starting it again in 1 s" in err
+    assert "node 'monitor' started again" in err
+    assert len(list(tmp_path.glob('solar_panel-*.png'))) == 1  # drawn by the new monitor
+
+
+def page_answers(port: int, timeout: float) -> bool:
+    """Whether the live page answers on `port` within `timeout` seconds."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        try:
+            with urllib.request.urlopen(f'http://127.0.0.1:{port}/', timeout=2) as page:
+                if page.status == 200:
+                    return True
+        except (urllib.error.URLError, OSError):
+            pass
+        time.sleep(0.2)
+    return False
+
+
 def test_a_killed_planner_resumes_its_mission_from_its_journal(tmp_path, ros_domain):
-    with paper_fleet(tmp_path, ros_domain) as (fleet, observer):
+    with paper_fleet(tmp_path, ros_domain, '--web-port', '0') as (fleet, observer):
         under_way(observer)
         mission = observer.status.mission_id
         kill(fleet, 'planner_node')
@@ -97,7 +129,8 @@ def test_a_killed_planner_resumes_its_mission_from_its_journal(tmp_path, ros_dom
 
 
 def test_without_respawn_a_killed_agent_ends_the_fleet(tmp_path, ros_domain):
-    with paper_fleet(tmp_path, ros_domain, '--no-respawn') as (fleet, observer):
+    with paper_fleet(tmp_path, ros_domain, '--web-port', '0', '--no-respawn') as (
+            fleet, observer):
         nodes = children(fleet.pid)
         under_way(observer, jobs=1)
         kill(fleet, "robot_name:='MARC1'")

@@ -24,6 +24,7 @@ from fjsp_planner.launcher.supervision import (
     EXIT_FAILED,
     MONITOR_FINISH,
     MONITOR_NODE,
+    MONITOR_PORT_PARAMETER,
     Fleet,
     FleetError,
 )
@@ -58,6 +59,16 @@ def _positive(kind):
     return parse
 
 
+def _port(text):
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f'expected a port number, got {text!r}') from None
+    if not 0 <= value <= 65535:
+        raise argparse.ArgumentTypeError(f'must be within [0, 65535], got {text}')
+    return value
+
+
 def parse_arguments(argv) -> argparse.Namespace:
     parser = argparse.ArgumentParser(
         prog='fleet',
@@ -90,6 +101,9 @@ def parse_arguments(argv) -> argparse.Namespace:
                         help='end the fleet (exit 1) when any node ends, rather than start it '
                              f'again after {POLICY.delay:g} s (given up on after {POLICY.limit} '
                              f'ends within {POLICY.window:g} s)')
+    parser.add_argument('--web-port', type=_port, metavar='PORT',
+                        help="port of the monitor's live page (default: the params file's, "
+                             'else 8080; 0: no page)')
     return parser.parse_args(argv)
 
 
@@ -102,10 +116,14 @@ def _summary(status: MissionStatus | None) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
+    monitor = {}
+    if args.exit_on_complete:
+        monitor['exit_on_complete'] = True
+    if args.web_port is not None:
+        monitor[MONITOR_PORT_PARAMETER] = args.web_port
     try:
         fleet = Fleet(args.scenario, panels=args.panels, time_scale=args.time_scale,
-                      params_file=args.params_file, out=args.out,
-                      monitor={'exit_on_complete': True} if args.exit_on_complete else None,
+                      params_file=args.params_file, out=args.out, monitor=monitor,
                       key=not args.unauthenticated, resumable=True)
     except FleetError as error:
         print(f'fleet: cannot run {args.scenario}:', file=sys.stderr)

@@ -38,6 +38,8 @@ from fjsp_planner.workspace import default_out_dir, installed_scenarios
 
 MONITOR_OUT_PARAMETER = 'out_dir'
 """The monitor's parameter naming the directory its outputs go to."""
+MONITOR_PORT_PARAMETER = 'web_port'
+"""The monitor's parameter naming the port of its live page."""
 JOURNAL_PARAMETER = 'journal_dir'
 """The planner's parameter naming where its mission journals go."""
 REPORTS_PARAMETER = 'reports_dir'
