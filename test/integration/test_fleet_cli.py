@@ -3,7 +3,9 @@ no node outlives the launcher, whether it is interrupted or killed, a node inter
 it starts ends without a traceback, and only the fleet's planner can end the launcher."""
 
 import copy
+import os
 import signal
+import subprocess
 import time
 
 import pytest
@@ -136,3 +138,24 @@ def test_forged_mission_statuses_do_not_end_the_fleet(tmp_path, ros_domain):
     assert 'does not verify with the fleet key (not signed)' in err
     assert 'mission statuses dropped: 4 that did not verify with the fleet key' in err
 
+
+def test_a_cancelled_mission_still_gets_its_summary_and_chart(tmp_path, ros_domain):
+    observer = Observer(ros_domain)
+    try:
+        # 0.5 s per unit: the mission lasts 16 s, long enough for the `mission` tool to start.
+        process = launcher(tmp_path, str(PAPER), '--exit-on-complete', '--time-scale', '0.5',
+                           '--web-port', '0', '--timeout', '120', domain=ros_domain)
+        observer.wait_for(lambda o: o.status.jobs_done >= 1, 60, 'the mission under way')
+        cancel = subprocess.run(
+            ['ros2', 'run', 'fjsp_planner', 'mission', 'cancel', '--reason', 'operator stop',
+             '--key-file', str(tmp_path / 'fleet.key')], capture_output=True, text=True,
+            timeout=60, env=dict(os.environ, ROS_DOMAIN_ID=str(ros_domain),
+                                 ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST'))
+        assert cancel.returncode == 0, cancel.stdout + cancel.stderr
+        out, err = process.communicate(timeout=120)
+    finally:
+        observer.close()
+    assert process.returncode == 1, out + err
+    assert 'was cancelled: operator stop' in err
+    assert 'cancelled: ' in out and 'Gantt chart:' in out  # the monitor's summary
+    assert len(list(tmp_path.glob('solar_panel-*.png'))) == 1

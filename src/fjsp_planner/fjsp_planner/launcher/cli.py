@@ -212,11 +212,11 @@ def _watch(fleet: Fleet, statuses: MissionWatch, supervisor: Supervisor, ended: 
                 ended_at = now
                 if not args.exit_on_complete:
                     print('fleet: the fleet stays up; Ctrl-C stops it', flush=True)
-        # Once complete, the monitor writes its summary and chart, then exits; a monitor
-        # that died meanwhile is started again to write them.
+        # Once the mission ended, complete or not, the monitor writes its summary and chart,
+        # then exits; a monitor that died meanwhile is started again to write them.
         if ended and args.exit_on_complete and (
-                ended[0] != 0 or supervisor.settled(MONITOR_NODE)
-                or MONITOR_NODE not in fleet.processes or now - ended_at > MONITOR_FINISH):
+                supervisor.settled(MONITOR_NODE) or MONITOR_NODE not in fleet.processes
+                or now - ended_at > MONITOR_FINISH):
             return ended[0]
         if args.timeout and not ended and now - began > args.timeout:
             print(f'fleet: the mission did not end within {args.timeout:g} s '

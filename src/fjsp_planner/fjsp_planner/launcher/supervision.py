@@ -50,7 +50,7 @@ DEFAULT_TIME_SCALE = 0.2
 STOP_GRACE = 5.0
 """Seconds a node has to stop after SIGINT before it is killed."""
 MONITOR_FINISH = 30.0
-"""Seconds the monitor may take, once the mission is complete, to write its summary."""
+"""Seconds the monitor may take, once the mission ended, to write its summary and chart."""
 
 EXIT_FAILED = 1
 EXIT_BAD_INPUT = 2
