@@ -1,6 +1,6 @@
 """`ros2 run fjsp_planner fleet` keeps its fleet up: a node killed mid-mission is started
 again and the mission completes, each job done once — an agent (re-planned around and back),
-the monitor (back on its web port), the planner (resumed from its journal). With
+the recorder, the monitor (back on its web port), the planner (resumed from its journal). With
 --no-respawn a killed node ends the fleet, as before."""
 
 import subprocess
@@ -70,14 +70,18 @@ def check_each_job_done_once(observer: Observer) -> None:
     check_nothing_redone(events, story)
 
 
-def test_a_killed_agent_comes_back_and_the_mission_completes(tmp_path, ros_domain):
+def test_a_killed_agent_and_recorder_come_back_and_the_mission_completes(tmp_path,
+                                                                         ros_domain):
     with paper_fleet(tmp_path, ros_domain, '--web-port', '0') as (fleet, observer):
         under_way(observer)
         kill(fleet, "robot_name:='MARC1'")
+        kill(fleet, '/recorder ')
         out, err = finish(fleet)
     check_each_job_done_once(observer)
-    assert "node 'agent_MARC1' killed by SIGKILL; starting it again in 1 s" in err
-    assert "node 'agent_MARC1' started again" in err
+    for node in ('agent_MARC1', 'recorder'):
+        assert f"node '{node}' killed by SIGKILL; starting it again in 1 s" in err
+        assert f"node '{node}' started again" in err
+    assert len(list(tmp_path.glob('fjsp_*.mcap'))) == 2  # the new recorder's file too
     # The planner planned around the lost robot, then with it again.
     story = [(e.kind, e.robot) for e in observer.mission_events]
     offline = story.index((MissionEvent.KIND_ROBOT_OFFLINE, 'MARC1'))
