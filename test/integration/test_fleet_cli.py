@@ -1,68 +1,23 @@
 """`ros2 run fjsp_planner fleet`: a complete mission exits 0, a bad scenario starts nothing,
-no node outlives the launcher, whether it is interrupted or killed, and a node interrupted
-while it starts ends without a traceback."""
+no node outlives the launcher, whether it is interrupted or killed, a node interrupted while
+it starts ends without a traceback, and only the fleet's planner can end the launcher."""
 
+import copy
 import os
 import signal
 import subprocess
 import time
-from pathlib import Path
 
 import pytest
 
-from fjsp_msgs.msg import MissionStatus
+from fjsp_common.auth import Signer, new_key, read_key
+from fjsp_common.contract import LATCHED_QOS, MISSION_STATUS_TOPIC
+from fjsp_common.fleet import PLANNER_NODE
+from fjsp_msgs.msg import Auth, MissionStatus
 from fjsp_planner.testing import Observer
 
+from fleet_command import launcher, still_running, wait_for_nodes
 from repo_paths import PAPER
-
-NODES = 6
-"""The planner, the paper's four robots and the monitor."""
-
-
-def launcher(out: Path, *args, domain: int) -> subprocess.Popen:
-    env = dict(os.environ, ROS_DOMAIN_ID=str(domain), ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST',
-               PYTHONUNBUFFERED='1')
-    return subprocess.Popen(['ros2', 'run', 'fjsp_planner', 'fleet', *args, '--out', str(out)],
-                            env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-
-
-def identity(pid: int) -> tuple[int, str] | None:
-    """(pid, start time) of a live process, None if it is gone or a zombie."""
-    try:
-        fields = Path(f'/proc/{pid}/stat').read_text().rsplit(')', 1)[1].split()
-    except OSError:
-        return None
-    return None if fields[0] in 'ZX' else (pid, fields[19])
-
-
-def children(pid: int) -> set[tuple[int, str]]:
-    found = set()
-    for entry in Path('/proc').iterdir():
-        if entry.name.isdigit():
-            try:
-                fields = (entry / 'stat').read_text().rsplit(')', 1)[1].split()
-            except OSError:
-                continue
-            if int(fields[1]) == pid and fields[0] not in 'ZX':
-                found.add((int(entry.name), fields[19]))
-    return found
-
-
-def wait_for_nodes(process: subprocess.Popen, timeout: float = 30.0) -> set:
-    deadline = time.monotonic() + timeout
-    while len(nodes := children(process.pid)) < NODES:
-        assert process.poll() is None, process.communicate()
-        assert time.monotonic() < deadline, f'only {len(nodes)} nodes after {timeout:g} s'
-        time.sleep(0.1)
-    return nodes
-
-
-def still_running(nodes, timeout: float) -> set:
-    """The nodes still alive after waiting up to `timeout` seconds for them to go."""
-    deadline = time.monotonic() + timeout
-    while (alive := {n for n in nodes if identity(n[0]) == n}) and time.monotonic() < deadline:
-        time.sleep(0.1)
-    return alive
 
 
 def test_a_complete_mission_exits_0(tmp_path, ros_domain):
@@ -144,3 +99,63 @@ def test_a_node_stopped_while_starting_ends_without_a_traceback(fjsp_fleet):
     codes = fleet.stop()
     assert codes['agent_MARC1'] in (0, -signal.SIGKILL), codes
     assert 'Traceback' not in fleet.log('agent_MARC1')
+
+
+def test_forged_mission_statuses_do_not_end_the_fleet(tmp_path, ros_domain):
+    observer = Observer(ros_domain)
+    try:
+        process = launcher(tmp_path / 'out', str(PAPER), '--exit-on-complete', '--time-scale',
+                           '0.15', '--timeout', '120', domain=ros_domain)
+        forger = observer.node.create_publisher(MissionStatus, MISSION_STATUS_TOPIC,
+                                                LATCHED_QOS)
+
+        def readers_matched(o) -> bool:
+            readers = o.node.get_subscriptions_info_by_topic('/mission_status')
+            return any(r.node_name.startswith('fleet_') for r in readers) \
+                and forger.get_subscription_count() >= len(readers)
+        observer.wait_for(lambda o: o.status.jobs_done >= 1
+                          and o.status.state == MissionStatus.STATE_EXECUTING
+                          and readers_matched(o), 60,
+                          "the mission under way, the forger matched to the launcher's reader")
+        wrong_key = Signer(read_key(new_key(tmp_path / 'other.key')), PLANNER_NODE)
+        real = copy.deepcopy(observer.status)
+        for state in (MissionStatus.STATE_FAILED, MissionStatus.STATE_COMPLETE):
+            forged = copy.deepcopy(real)
+            forged.state, forged.jobs_done, forged.jobs_total = state, 12, 12
+            forged.projected_makespan = forged.planned_makespan = 1.25
+            forged.blocked_reasons, forged.auth = ['a forger says so'], Auth()
+            # One at a time: the launcher keeps the latest status only, as every reader.
+            for message in (forged, wrong_key.sign(copy.deepcopy(forged), '/mission_status')):
+                forger.publish(message)
+                time.sleep(0.3)
+            assert process.poll() is None, process.communicate()
+        out, err = process.communicate(timeout=180)
+    finally:
+        observer.close()
+    assert process.returncode == 0, out + err
+    assert 'complete: 12/12 jobs done' in out and 'makespan 1.25' not in out
+    assert 'a forger says so' not in out + err
+    assert 'does not verify with the fleet key (not signed)' in err
+    assert 'mission statuses dropped: 4 that did not verify with the fleet key' in err
+
+
+def test_a_cancelled_mission_still_gets_its_summary_and_chart(tmp_path, ros_domain):
+    observer = Observer(ros_domain)
+    try:
+        # 0.5 s per unit: the mission lasts 16 s, long enough for the `mission` tool to start.
+        process = launcher(tmp_path, str(PAPER), '--exit-on-complete', '--time-scale', '0.5',
+                           '--web-port', '0', '--timeout', '120', domain=ros_domain)
+        observer.wait_for(lambda o: o.status.jobs_done >= 1, 60, 'the mission under way')
+        cancel = subprocess.run(
+            ['ros2', 'run', 'fjsp_planner', 'mission', 'cancel', '--reason', 'operator stop',
+             '--key-file', str(tmp_path / 'fleet.key')], capture_output=True, text=True,
+            timeout=60, env=dict(os.environ, ROS_DOMAIN_ID=str(ros_domain),
+                                 ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST'))
+        assert cancel.returncode == 0, cancel.stdout + cancel.stderr
+        out, err = process.communicate(timeout=120)
+    finally:
+        observer.close()
+    assert process.returncode == 1, out + err
+    assert 'was cancelled: operator stop' in err
+    assert 'cancelled: ' in out and 'Gantt chart:' in out  # the monitor's summary
+    assert len(list(tmp_path.glob('solar_panel-*.png'))) == 1

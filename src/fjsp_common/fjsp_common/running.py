@@ -88,7 +88,7 @@ def run_node(make_node: Callable[[], Node], logger: str, args=None,
     stop = threading.Event()
     for sig in STOP_SIGNALS:
         signal.signal(sig, _interrupt)
-    node = None
+    node = executor = None
     code = 0
     try:
         node = make_node()
@@ -108,6 +108,10 @@ def run_node(make_node: Callable[[], Node], logger: str, args=None,
         # clean-up into a traceback.
         for sig in STOP_SIGNALS:
             signal.signal(sig, signal.SIG_IGN)
+        # Left to its finaliser, the executor would destroy its guard conditions at exit,
+        # after rclpy: "Exception ignored in Executor.__del__ ... InvalidHandle".
+        if executor is not None:
+            executor.shutdown()
         if node is not None:
             try:
                 node.destroy_node()

@@ -30,7 +30,6 @@ import fcntl
 import math
 import os
 import random
-import signal
 import subprocess
 import tempfile
 import time
@@ -55,6 +54,7 @@ from fjsp_planner.execution.tracking import relaxed_distances
 from fjsp_planner.faults import inject_fault
 from fjsp_planner.launcher.hosts import HostsUnavailableError, Network
 from fjsp_planner.launcher.listener import Listener, environment
+from fjsp_planner.launcher.respawn import how_it_ended
 from fjsp_planner.launcher.supervision import Fleet, find_executable
 from fjsp_planner.model.problem import Problem
 from fjsp_planner.model.schedule import JobAssignment, Schedule
@@ -294,7 +294,7 @@ class FleetHarness(Fleet):
             if not ended:
                 raise
             pytest.fail(f'{failure}; not running: ' + ', '.join(
-                f'{name} ({_how_it_ended(code)})' for name, code in sorted(ended.items())),
+                f'{name} ({how_it_ended(code)})' for name, code in sorted(ended.items())),
                 pytrace=False)
 
     def inject_fault(self, robot: str, fault: str, factor: float | None = None,
@@ -396,15 +396,6 @@ def pytest_collection_modifyitems(items) -> None:
     LAN whose bridge came after any other test's participant in this process announces only
     addresses the LAN's hosts cannot reach, and hears nothing."""
     items.sort(key=lambda item: 'fjsp_network' not in getattr(item, 'fixturenames', ()))
-
-
-def _how_it_ended(code: int) -> str:
-    if code < 0:
-        try:
-            return f'killed by {signal.Signals(-code).name}'
-        except ValueError:
-            return f'killed by signal {-code}'
-    return f'exited with {code}'
 
 
 @pytest.fixture

@@ -1,5 +1,7 @@
 """`ros2 run fjsp_planner fleet`: a scenario run on the node network from the command line,
-until Ctrl-C or the end of the mission, its outcome as the exit code."""
+until Ctrl-C or the end of the mission, its outcome as the exit code. It starts again a node
+that ended (`launcher.respawn` decides when) and believes only the mission statuses its
+planner signed (`launcher.status`)."""
 
 import argparse
 import math
@@ -8,22 +10,29 @@ import sys
 import time
 from pathlib import Path
 
-from fjsp_common.auth import KEY_FILE_VARIABLE
-from fjsp_common.contract import LATCHED_QOS, MISSION_STATUS_TOPIC
+from fjsp_common.auth import KEY_FILE_VARIABLE, read_key
+from fjsp_common.contract import MISSION_STATUS
 from fjsp_common.decimals import decimals
+from fjsp_common.fleet import PLANNER_NODE
 from fjsp_msgs.msg import MissionStatus
 from fjsp_planner.launcher.listener import Listener
+from fjsp_planner.launcher.respawn import RespawnPolicy, Supervisor
+from fjsp_planner.launcher.status import MissionWatch
 from fjsp_planner.launcher.supervision import (
     DEFAULT_TIME_SCALE,
     EXIT_BAD_INPUT,
     EXIT_FAILED,
     MONITOR_FINISH,
     MONITOR_NODE,
+    MONITOR_PORT_PARAMETER,
     Fleet,
     FleetError,
 )
 from fjsp_planner.model.scenario import scenario_warnings
 from fjsp_planner.workspace import default_out_dir
+
+POLICY = RespawnPolicy()
+"""When the nodes of a fleet that ended are started again."""
 
 
 class _SignalError(Exception):
@@ -48,6 +57,16 @@ def _positive(kind):
             raise argparse.ArgumentTypeError(f'must be > 0, got {text}')
         return value
     return parse
+
+
+def _port(text):
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f'expected a port number, got {text!r}') from None
+    if not 0 <= value <= 65535:
+        raise argparse.ArgumentTypeError(f'must be within [0, 65535], got {text}')
+    return value
 
 
 def parse_arguments(argv) -> argparse.Namespace:
@@ -78,6 +97,13 @@ def parse_arguments(argv) -> argparse.Namespace:
                              '<out>/fleet.key and given to every node; docs/security.md)')
     parser.add_argument('--no-recording', action='store_true',
                         help='do not record the mission topics to <out>/fjsp_<time>.mcap')
+    parser.add_argument('--no-respawn', action='store_true',
+                        help='end the fleet (exit 1) when any node ends, rather than start it '
+                             f'again after {POLICY.delay:g} s (given up on after {POLICY.limit} '
+                             f'ends within {POLICY.window:g} s)')
+    parser.add_argument('--web-port', type=_port, metavar='PORT',
+                        help="port of the monitor's live page (default: the params file's, "
+                             'else 8080; 0: no page)')
     return parser.parse_args(argv)
 
 
@@ -90,11 +116,15 @@ def _summary(status: MissionStatus | None) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
+    monitor = {}
+    if args.exit_on_complete:
+        monitor['exit_on_complete'] = True
+    if args.web_port is not None:
+        monitor[MONITOR_PORT_PARAMETER] = args.web_port
     try:
         fleet = Fleet(args.scenario, panels=args.panels, time_scale=args.time_scale,
-                      params_file=args.params_file, out=args.out,
-                      monitor={'exit_on_complete': True} if args.exit_on_complete else None,
-                      key=not args.unauthenticated)
+                      params_file=args.params_file, out=args.out, monitor=monitor,
+                      key=not args.unauthenticated, resumable=True)
     except FleetError as error:
         print(f'fleet: cannot run {args.scenario}:', file=sys.stderr)
         for problem in error.problems:
@@ -105,8 +135,15 @@ def run(args: argparse.Namespace) -> int:
     except RuntimeError as error:  # rclpy's RCLError, e.g. a bad ROS_DOMAIN_ID
         print(f'fleet: could not start ROS: {error}', file=sys.stderr)
         return EXIT_FAILED
-    latest: list[MissionStatus] = []
-    watch.subscribe(MissionStatus, MISSION_STATUS_TOPIC, LATCHED_QOS, latest.append)
+    statuses = MissionWatch(read_key(fleet.key_file) if fleet.key_file else None,
+                            watch.node.resolve_topic_name(MISSION_STATUS.name))
+
+    def receive(msg):
+        if warning := statuses.receive(msg):
+            print(f'fleet: {warning}', file=sys.stderr, flush=True)
+    watch.subscribe(MISSION_STATUS.type, MISSION_STATUS.name, MISSION_STATUS.qos, receive)
+    supervisor = Supervisor(None if args.no_respawn else POLICY, essential={PLANNER_NODE},
+                            may_finish={MONITOR_NODE} if args.exit_on_complete else ())
     ended: list[int] = []
     """The mission's exit code, once it has ended."""
     previous = {sig: signal.signal(sig, _stop_signal) for sig in (signal.SIGINT, signal.SIGTERM)}
@@ -120,12 +157,16 @@ def run(args: argparse.Namespace) -> int:
         if fleet.key_file is not None:
             print(f'fleet: authenticated with the key in {fleet.key_file}; tools need it too: '
                   f'export {KEY_FILE_VARIABLE}={fleet.key_file}', flush=True)
-        return _watch(fleet, latest, ended, args)
+        else:
+            print('fleet: unauthenticated (--unauthenticated): any node on this ROS domain can '
+                  'publish mission statuses this launcher believes, and plans the robots '
+                  'follow', flush=True)
+        return _watch(fleet, statuses, supervisor, ended, args)
     except _SignalError as stopped:
         if ended:
             return ended[0]
         print(f'fleet: stopped by {stopped} before the mission ended '
-              f'({_summary(latest[-1] if latest else None)})', file=sys.stderr)
+              f'({_summary(statuses.latest)})', file=sys.stderr)
         return stopped.code
     finally:
         # Stopping is bounded (SIGKILL after the grace period); a second Ctrl-C must not
@@ -134,37 +175,50 @@ def run(args: argparse.Namespace) -> int:
             signal.signal(sig, signal.SIG_IGN)
         fleet.stop()
         watch.close()
+        if tally := statuses.tally():
+            print(f'fleet: {tally}', file=sys.stderr)
         for sig, handler in previous.items():
             signal.signal(sig, handler)
 
 
-def _watch(fleet: Fleet, latest: list, ended: list, args) -> int:
+def _watch(fleet: Fleet, statuses: MissionWatch, supervisor: Supervisor, ended: list,
+           args) -> int:
     """Until the outcome is decided: the exit code, its reason printed. Without
-    --exit-on-complete only a node's death or the timeout decides; Ctrl-C ends it."""
+    --exit-on-complete only the loss of a node the fleet cannot go on without, or the
+    timeout, decides; Ctrl-C ends it."""
     began = time.monotonic()
     ended_at = None
     while True:
         time.sleep(0.1)
-        status = latest[-1] if latest else None
+        now = time.monotonic()
+        status = statuses.latest
+        for name, code in fleet.exited().items():
+            if not supervisor.watches(name):
+                continue
+            verdict = supervisor.ended(name, code, now)
+            if verdict.finished:
+                continue  # the monitor, its summary written; the mission status decides
+            print(f'fleet: {verdict.describe(now)} ({_summary(status)}); its log: '
+                  f'{fleet.logs / name}.log', file=sys.stderr, flush=True)
+            if verdict.ends_fleet:
+                return EXIT_FAILED
+        for name in supervisor.due(now):
+            print(f"fleet: node '{name}' started again (pid {fleet.restart(name).pid})",
+                  file=sys.stderr, flush=True)
         if not ended and status is not None:
             code = _ended(status)
             if code is not None:
                 ended.append(code)
-                ended_at = time.monotonic()
+                ended_at = now
                 if not args.exit_on_complete:
                     print('fleet: the fleet stays up; Ctrl-C stops it', flush=True)
-        if ended and args.exit_on_complete:
-            # Once complete, the monitor writes its summary and chart, then exits.
-            if ended[0] != 0 or fleet.processes[MONITOR_NODE].poll() is not None \
-                    or time.monotonic() - ended_at > MONITOR_FINISH:
-                return ended[0]
-        for name, code in fleet.exited().items():
-            if name == MONITOR_NODE and code == 0 and args.exit_on_complete:
-                continue  # it saw the mission end; the mission status decides above
-            print(f"fleet: node '{name}' exited with code {code} "
-                  f'({_summary(status)}); its log: {fleet.logs / name}.log', file=sys.stderr)
-            return EXIT_FAILED
-        if args.timeout and not ended and time.monotonic() - began > args.timeout:
+        # Once the mission ended, complete or not, the monitor writes its summary and chart,
+        # then exits; a monitor that died meanwhile is started again to write them.
+        if ended and args.exit_on_complete and (
+                supervisor.settled(MONITOR_NODE) or MONITOR_NODE not in fleet.processes
+                or now - ended_at > MONITOR_FINISH):
+            return ended[0]
+        if args.timeout and not ended and now - began > args.timeout:
             print(f'fleet: the mission did not end within {args.timeout:g} s '
                   f'({_summary(status)})', file=sys.stderr)
             return EXIT_FAILED

@@ -1,5 +1,6 @@
 """The fleet's processes: the planner, one generic robot agent per robot a scenario lists, and
-the monitor, each in a process of its own, from start-up to the end of the mission.
+the monitor, each in a process of its own, from start-up to the end of the mission; a node
+that ended can be started again as it was (`Fleet.restart`; when to, `launcher.respawn`).
 
 `launch` and `launch_ros` are not published on PyPI, so this is the project's one launcher,
 used alike by `ros2 run fjsp_planner fleet`, `ros2_ws/demo.sh`, the test harness
@@ -37,13 +38,19 @@ from fjsp_planner.workspace import default_out_dir, installed_scenarios
 
 MONITOR_OUT_PARAMETER = 'out_dir'
 """The monitor's parameter naming the directory its outputs go to."""
+MONITOR_PORT_PARAMETER = 'web_port'
+"""The monitor's parameter naming the port of its live page."""
+JOURNAL_PARAMETER = 'journal_dir'
+"""The planner's parameter naming where its mission journals go."""
+REPORTS_PARAMETER = 'reports_dir'
+"""The agents' parameter naming where each keeps its task events."""
 DEFAULT_SCENARIO = 'solar_panel.yaml'
 DEFAULT_TIME_SCALE = 0.2
 """Wall seconds per schedule unit: the paper's 32-unit mission takes about 6 s."""
 STOP_GRACE = 5.0
 """Seconds a node has to stop after SIGINT before it is killed."""
 MONITOR_FINISH = 30.0
-"""Seconds the monitor may take, once the mission is complete, to write its summary."""
+"""Seconds the monitor may take, once the mission ended, to write its summary and chart."""
 
 EXIT_FAILED = 1
 EXIT_BAD_INPUT = 2
@@ -122,6 +129,11 @@ class Fleet:
     `{'agent_R1': ['ip', 'netns', 'exec', 'rover1']}` to start it in another network
     namespace, on every (re)start. Logs go to `<out>/logs/<node>.log`.
 
+    With `resumable`, the planner keeps its mission journal (`journal_dir`) and each agent
+    its reports (`reports_dir`) in `<out>/journal/<UTC start time>-<pid>`, unless the
+    parameters file sets where: a planner started again resumes the mission and nothing done
+    is redone (docs/ros-interfaces.md, "Journal and planner restart").
+
     Start nodes from a thread that lives as long as the fleet (the main thread): the kernel
     sends the parent-death signal when the thread that started a node ends.
     """
@@ -131,7 +143,7 @@ class Fleet:
                  domain: int | None = None, env: dict | None = None,
                  planner: dict | None = None, agents: dict | None = None,
                  monitor: dict | None = None, key: bool = False,
-                 prefixes: dict | None = None):
+                 prefixes: dict | None = None, resumable: bool = False):
         problems = []
         self.scenario = resolve_scenario(scenario)
         self.problem: Problem | None = None
@@ -181,8 +193,20 @@ class Fleet:
             self.env[KEY_FILE_VARIABLE] = str(self.key_file)
             for params in self.extra.values():
                 params.setdefault('fleet_key_file', self.key_file)
+        if resumable:
+            # A fresh directory per fleet: a planner given one that holds an earlier run's
+            # journal of the same scenario would not run the mission again.
+            journal = self.out / 'journal' / (
+                f"{time.strftime('%Y%m%dT%H%M%S', time.gmtime())}-{os.getpid()}")
+            if not self._file_sets(PLANNER_NODE, JOURNAL_PARAMETER):
+                self.extra[PLANNER_NODE].setdefault(JOURNAL_PARAMETER, journal)
+            if not any(self._file_sets(agent_node_name(r.name), REPORTS_PARAMETER)
+                       for r in self.problem.robots):
+                self.extra['agents'].setdefault(REPORTS_PARAMETER, journal)
         self.prefixes = {name: list(prefix) for name, prefix in (prefixes or {}).items()}
         self.processes: dict[str, subprocess.Popen] = {}
+        self._starts: dict[str, tuple] = {}
+        """How each node was last started: the arguments of `start_node`."""
         self._streams: list[threading.Thread] = []
 
     # --- starting --------------------------------------------------------------------
@@ -244,6 +268,7 @@ class Fleet:
         previous = self.processes.get(name)
         if previous is not None and previous.poll() is None:
             raise FleetError([f"node '{name}' is already running (pid {previous.pid})"])
+        self._starts[name] = (package, executable, params, tuple(ros_args), stream, prefix)
         prefix = self.prefixes.get(name, ()) if prefix is None else prefix
         command = [*prefix, str(find_executable(package, executable)), '--ros-args']
         if self.params_file is not None:
@@ -270,6 +295,12 @@ class Fleet:
             self._streams.append(copier)
         self.processes[name] = process
         return process
+
+    def restart(self, name: str) -> subprocess.Popen:
+        """Start node `name`, which has ended, again as it was last started; its log goes
+        on."""
+        package, executable, params, ros_args, stream, prefix = self._starts[name]
+        return self.start_node(name, package, executable, params, ros_args, stream, prefix)
 
     def _file_sets(self, node: str, parameter: str) -> bool:
         return sets_parameter(self.params, node, parameter)
