@@ -13,8 +13,9 @@ from fjsp_planner.model.problem import FixedJob, Job, Problem, Robot
 from fjsp_planner.model.scenario import load_scenario
 from fjsp_planner.model.schedule import Status
 from fjsp_planner.model.validate import validate
+from fjsp_planner.solving.bounds.jobs import critical_path_bound
 from fjsp_planner.solving.greedy import greedy_schedule
-from fjsp_planner.solving.solve import critical_path_bound, solve
+from fjsp_planner.solving.solve import solve
 
 from repo_paths import PAPER
 

@@ -32,7 +32,7 @@ from fractions import Fraction
 from fjsp_planner.model.problem import FixedJob, Job, Problem, Robot, max_staffed
 from fjsp_planner.model.schedule import JobAssignment, Result, Schedule, Status
 from fjsp_planner.model.validate import validate
-from fjsp_planner.solving.bounds.panel import critical_path_bound
+from fjsp_planner.solving.bounds.jobs import critical_path_bound
 from fjsp_planner.solving.greedy import (
     GreedyOutOfTimeError,
     GreedyStuckError,

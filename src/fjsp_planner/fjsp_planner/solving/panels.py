@@ -17,6 +17,7 @@ from fjsp_planner.model.problem import Problem
 from fjsp_planner.model.schedule import JobAssignment, Schedule
 from fjsp_planner.model.validate import validate
 from fjsp_planner.solving.bounds import panel as bounds
+from fjsp_planner.solving.bounds.geometry import crossing_cost
 from fjsp_planner.solving.greedy import GreedyOutOfTimeError, GreedyStuckError, guided_schedule
 
 
@@ -38,7 +39,7 @@ def stitched_schedule(problem: Problem, incumbent: Fraction, time_limit: float, 
     if full.schedule is None or alone.schedule is None:
         return None, alone.lower_bound
     guide, offset = {}, Fraction(0)
-    cross = max(bounds.crossing_cost(problem, r.name) for r in unhelped.robots)
+    cross = max(crossing_cost(problem, r.name) for r in unhelped.robots)
     for k, names in enumerate(problem.panels):
         copy = full.schedule if k == 0 else alone.schedule
         base = problem.panels[0]

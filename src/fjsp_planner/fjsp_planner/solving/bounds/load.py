@@ -36,13 +36,10 @@ from fractions import Fraction
 from ortools.sat.python import cp_model
 
 from fjsp_planner.model.problem import Problem
+from fjsp_planner.solving.bounds.geometry import panel_distance, travel_factor
+from fjsp_planner.solving.bounds.jobs import heads_and_tails, staffings
 from fjsp_planner.solving.bounds.machine import BOUND_SUBSOLVERS
-from fjsp_planner.solving.bounds.panel import (
-    _heads_and_tails,
-    _panel_distance,
-    _staffings,
-    panel_limits,
-)
+from fjsp_planner.solving.bounds.panel import panel_limits
 
 MAX_GRID = 1000
 MAX_CHOICES = 20_000
@@ -84,8 +81,8 @@ def _solve(problem: Problem, incumbent: Fraction, choices, time_limit: float, wo
     `_cut_jobs`) the waits around them count too, from `floor` (what is proven without)."""
     panels = problem.panels
     places, between_places = _places(problem)
-    between_panels = _panel_distance(problem)
-    factors = {r.name: _travel_factor(problem, r.name) for r in problem.robots}
+    between_panels = panel_distance(problem)
+    factors = {r.name: travel_factor(problem, r.name) for r in problem.robots}
     values = [d for found in choices.values() for d, _ in found]
     values += [r.release_time for r in problem.robots]
     values += [f * d for f in factors.values() for d in (between_places, between_panels)]
@@ -242,7 +239,7 @@ def _choices(problem: Problem, incumbent: Fraction):
     """job -> [(least duration, robot set)]: a set is kept only if no smaller set is as
     fast (it would load more robots for nothing), nor does it end the job at or after
     `incumbent` whatever else happens (the fastest is kept regardless)."""
-    heads, tails = _heads_and_tails(problem)
+    heads, tails = heads_and_tails(problem)
     robots = sorted(r.name for r in problem.robots)
     out, known = {}, {}
     for job in problem.jobs:
@@ -258,20 +255,13 @@ def _choices(problem: Problem, incumbent: Fraction):
 def _fitting(problem, plans, robots, around, incumbent):
     fastest = {}
     for plan in plans:
-        for staffing in _staffings(problem, plan, robots):
+        for staffing in staffings(problem, plan, robots):
             key = frozenset(r for r, _ in staffing)
             length = max(problem.duration(r, q) for r, q in staffing)
             fastest[key] = min(length, fastest.get(key, length))
     found = sorted((d, tuple(sorted(s))) for s, d in fastest.items()
                    if not any(o < s and fastest[o] <= d for o in fastest))
     return [(d, s) for d, s in found if around + d < incumbent] or found[:1]
-
-
-def _travel_factor(problem: Problem, robot: str) -> Fraction:
-    if problem.locomote is None:
-        return Fraction(0)
-    r = problem.robot(robot)
-    return problem.robot_types[r.type][problem.locomote] / r.speed
 
 
 def _places(problem: Problem):

@@ -10,7 +10,7 @@ from fractions import Fraction
 
 from fjsp_planner.model.problem import Problem
 from fjsp_planner.solving.bounds import panel as bounds
-from fjsp_planner.solving.bounds.panel import crossing_cost
+from fjsp_planner.solving.bounds.geometry import crossing_cost
 from fjsp_planner.solving.cpsat.grid import TimeGrid
 from fjsp_planner.solving.cpsat.variables import JobVariables, RouteVariables, check
 
