@@ -2,14 +2,16 @@
 
 Jobs are placed one at a time, each at the assignment (plan and robots) that completes it
 earliest. A holding arc (j, j', q) is placed as one block: j, then j' straight away with j's
-type-q robots, so no other job can come between them on the holders' routes.
+type-q robots, so no other job can come between them on the holders' routes. When no block
+can be placed (two arcs whose held jobs each wait for the other's jig job), j is placed
+alone and its holders are kept for j', which is placed once its other predecessors are; a
+pass that gets stuck so comes back to its last such choice and tries another.
 
 `guided_schedule` places jobs instead in the order and with the staffing of a schedule to
 follow (a plan a failure broke, or copies of one-panel optima), wherever that is still
 possible, so that what worked before is kept and only exact times are recomputed.
 """
 
-import itertools
 import random
 import time
 from dataclasses import dataclass
@@ -19,6 +21,8 @@ from fjsp_planner.model.problem import Problem
 from fjsp_planner.model.schedule import JobAssignment, Schedule
 
 MAX_CANDIDATES_PER_PLAN = 2000
+MAX_BACKTRACKS = 1000
+"""Partial placements of holding chains undone in one pass before it gives up as stuck."""
 
 
 @dataclass(frozen=True)
@@ -170,7 +174,8 @@ class _State:
         free_robots = [r for r in self.free
                        if r not in forced and self.reserved.get(r, name) == name]
         arrive_f = {r: float(self.arrival(r, job.location)) for r in (*free_robots, *forced)}
-        ready_f = float(ready)
+        ready_f = max([float(ready)] + [arrive_f[r] for r in forced])
+        forced_longest = max((self.duration_f(r, q) for r, q in forced.items()), default=0.0)
         out = []
         for plan_index, plan in enumerate(job.plans):
             remaining = list(plan)
@@ -179,18 +184,16 @@ class _State:
                     break
                 remaining.remove(q)
             else:
-                count = 0
-                for chosen in itertools.permutations(free_robots, len(remaining)):
+                remaining.sort()
+                able = {q: [(r, arrive_f[r], d) for r in free_robots
+                            if (d := self.duration_f(r, q)) is not None]
+                        for q in set(remaining)}
+                found = []
+                _staff(remaining, able, 0, 0, [], ready_f, forced_longest, found)
+                for start, end, chosen in found:
                     robots = dict(forced)
                     robots.update(zip(chosen, remaining, strict=True))
-                    times = [self.duration_f(r, q) for r, q in robots.items()]
-                    if None in times:
-                        continue
-                    start = max(ready_f, *(arrive_f[r] for r in robots))
-                    out.append((start + max(times), start, plan_index, robots))
-                    count += 1
-                    if count >= MAX_CANDIDATES_PER_PLAN:
-                        break
+                    out.append((end, start, plan_index, robots))
         out.sort(key=lambda c: (c[0], c[1]))
         return out[:self.breadth.staffings]
 
@@ -200,6 +203,28 @@ class _State:
             time = self.problem.duration(robot, q)
             self.durations[key] = None if time is None else float(time)
         return self.durations[key]
+
+
+def _staff(operations, able, k, first, chosen, start, longest, found):
+    """Append to `found` (start, end, robots) for each way to give `operations[k:]` (sorted)
+    distinct robots not in `chosen`, up to MAX_CANDIDATES_PER_PLAN: equal operations take
+    robots in the order of `able` (robot, arrival, duration), so each set is found once."""
+    if k == len(operations):
+        found.append((start, start + longest, tuple(chosen)))
+        return
+    options = able[operations[k]]
+    for index in range(first, len(options)):
+        if len(found) >= MAX_CANDIDATES_PER_PLAN:
+            return
+        robot, arrival, duration = options[index]
+        if robot in chosen:
+            continue
+        chosen.append(robot)
+        following = index + 1 if k + 1 < len(operations) and operations[k + 1] == operations[
+            k] else 0
+        _staff(operations, able, k + 1, following, chosen, max(start, arrival),
+               max(longest, duration), found)
+        chosen.pop()
 
 
 def _first_pass(problem: Problem, deadline) -> Schedule:
@@ -233,30 +258,52 @@ def _one_pass(problem: Problem, rng, deadline=None, breadth=None, guide=None) ->
         state.commit(JobAssignment(name, fixed.plan, fixed.start, fixed.end,
                                    dict(fixed.robots)))
     pending = [j.name for j in problem.jobs if j.name not in problem.fixed]
+    backtrack, tries = [], 0
     while pending:
         if deadline is not None and time.monotonic() > deadline:
             raise GreedyOutOfTimeError
-        options = []
-        for name in _by_readiness(state, pending):
-            if name in state.held_from and state.held_from[name][0] not in state.jobs:
-                continue
-            block = _block_option(state, name)
-            if block is not None:
-                options.append(block)
-                if state.breadth.jobs is not None and len(options) == state.breadth.jobs:
-                    break
-        if not options:
-            raise GreedyStuckError('greedy scheduling found no job it can place next among '
-                              + ', '.join(sorted(pending)))
-        options.sort(key=lambda o: (_guide_order(state, o[1][0][0]), o[0]))
-        if rng is not None and len(options) > 1 and rng.random() < 0.3:
-            choice = options[rng.randrange(min(3, len(options)))]
+        options = _options(state, pending)
+        if options:
+            options.sort(key=lambda o: (_guide_order(state, o[1][0][0]), o[0]))
+            if rng is not None and len(options) > 1 and rng.random() < 0.3:
+                choice = options[rng.randrange(min(3, len(options)))]
+            else:
+                choice = options[0]
         else:
+            # Each partial placement keeps holders from other jobs: the first tried may
+            # leave a job no robots, so the others are kept to come back to.
+            options = sorted(_options(state, pending, partial=True),
+                             key=lambda o: (_guide_order(state, o[1][0][0]), o[0]))
+            if not options:
+                if not backtrack or tries >= MAX_BACKTRACKS:
+                    raise GreedyStuckError('greedy scheduling found no job it can place next '
+                                           'among ' + ', '.join(sorted(pending)))
+                state, pending, options = backtrack.pop()
+                tries += 1
             choice = options[0]
+            if len(options) > 1:
+                backtrack.append((state.copy(), list(pending), options[1:]))
         for name, plan, robots in choice[1]:
             state.place(name, plan, robots)
             pending.remove(name)
     return Schedule(state.jobs, {r: tuple(s) for r, s in state.sequences.items()})
+
+
+def _options(state: _State, pending, partial=False) -> list:
+    """(score, [placements]) for the jobs that can be placed next, with the jobs they hold
+    into; with `partial`, a holding chain whose held job still waits for another job is
+    offered up to that job, its holders kept for it (two arcs whose held jobs each wait for
+    the other's jig job can only be placed so)."""
+    options = []
+    for name in _by_readiness(state, pending):
+        if name in state.held_from and state.held_from[name][0] not in state.jobs:
+            continue
+        block = _block_option(state, name, partial)
+        if block is not None:
+            options.append(block)
+            if state.breadth.jobs is not None and len(options) == state.breadth.jobs:
+                break
+    return options
 
 
 def _guide_order(state: _State, name) -> float:
@@ -296,15 +343,20 @@ def _by_readiness(state: _State, pending):
     return [name for _, _, name in ready]
 
 
-def _block_option(state: _State, name):
-    """(score, [placements]) for the job and the jobs it holds into, or None if not ready."""
+def _block_option(state: _State, name, partial=False):
+    """(score, [placements]) for the job and the jobs it holds into, or None if not ready;
+    with `partial`, for the job and those it holds into up to the first that waits for a job
+    outside the chain."""
     chain = [name]
     while chain[-1] in state.holds_into:
         chain.append(state.holds_into[chain[-1]][0])
-    for member in chain[1:]:
+    for index, member in enumerate(chain[1:], 1):
         others = [a for a in state.predecessors[member] if a not in chain]
         if any(a not in state.jobs for a in others):
-            return None
+            if not partial:
+                return None
+            chain = chain[:index]
+            break
     ready = state.ready_at(name)
     if ready is None:
         return None
