@@ -2,10 +2,11 @@
 
 import pytest
 
-from fjsp_planner.model.generator import random_scenario
+from fjsp_planner.model.generator import Shape, random_scenario
 from fjsp_planner.model.scenario import parse_scenario
 from fjsp_planner.model.validate import validate
 from fjsp_planner.solving.greedy import greedy_schedule
+from fjsp_planner.solving.solve import solve
 
 
 def test_two_holding_arcs_whose_held_jobs_wait_for_each_other_are_placed():
@@ -36,3 +37,11 @@ def test_every_generated_scenario_gets_a_valid_greedy_schedule():
         problem = parse_scenario(random_scenario(seed))
         assert validate(problem, greedy_schedule(problem, passes=4)) == [], f'seed {seed}'
 
+
+def test_a_limit_too_short_for_a_greedy_pass_still_gives_a_valid_schedule():
+    """29 jobs in 10 ms: no greedy pass ends within its share of the limit, so `solve`
+    waits for one quick pass rather than return nothing."""
+    problem = parse_scenario(random_scenario(3, Shape(jobs=29, robots=6, robot_types=3)))
+    result = solve(problem, time_limit=0.01)
+    assert result.schedule is not None
+    assert validate(problem, result.schedule) == []

@@ -32,8 +32,10 @@ def solve(problem: Problem, solver: str = 'cpsat', time_limit: float = 10.0, wor
 
     The whole call (greedy, model building, solving, keeping assignments) takes at most
     `time_limit` seconds, plus the solver's reaction time to its own limit (milliseconds),
-    for problems up to the size limit of the scenario checks (about 1000 jobs). `workers`
-    must lie in 1..MAX_WORKERS.
+    for problems up to the size limit of the scenario checks (1000 jobs); but without a
+    valid hint, a limit too short for any greedy pass is exceeded by one quick pass, so that
+    a schedule is returned whenever a quick pass finds one. `workers` must lie in
+    1..MAX_WORKERS.
     """
     if solver not in SOLVERS:
         raise ValueError(f"unknown solver '{solver}'; choose one of {', '.join(SOLVERS)}")

@@ -15,6 +15,7 @@ from fjsp_planner.solving.greedy import (
     GreedyOutOfTimeError,
     GreedyStuckError,
     greedy_schedule,
+    quick_schedule,
 )
 
 GREEDY_PASSES_SHARE = 0.02
@@ -39,7 +40,8 @@ class Start:
 def find_start(problem: Problem, hint: Schedule | None, began: float, greedy_time: float,
                time_limit: float) -> Start:
     """The greedy schedule (within `greedy_time` seconds of `began`) and the hint, each kept
-    only if valid; the hint gives way to a shorter greedy schedule."""
+    only if valid; the hint gives way to a shorter greedy schedule. Without a valid hint, a
+    quick greedy pass is waited for when no pass finished in time."""
     notes = ()
     if hint is not None and validate(problem, hint):
         # Repairing a broken hint can cost CP-SAT more than starting from the greedy one.
@@ -50,7 +52,9 @@ def find_start(problem: Problem, hint: Schedule | None, began: float, greedy_tim
     except GreedyStuckError:
         greedy = None
     except GreedyOutOfTimeError:
-        greedy, notes = None, notes + (f'no greedy schedule within {greedy_time:g} s',)
+        greedy = None if hint is not None else _quick(problem)
+        notes += (f'no greedy schedule within {greedy_time:g} s' + (
+            '' if greedy is None else '; a quick pass waited for'),)
     if greedy is not None and validate(problem, greedy):
         # Its makespan would cap the horizon; an invalid one could make CP-SAT miss schedules.
         greedy, notes = None, notes + ('the greedy schedule was invalid; not used',)
@@ -58,6 +62,15 @@ def find_start(problem: Problem, hint: Schedule | None, began: float, greedy_tim
         # The horizon comes from the shorter one, and would cut the longer hint off.
         hint = greedy
     return Start(greedy, hint, notes)
+
+
+def _quick(problem: Problem) -> Schedule | None:
+    """One quick greedy pass, without a deadline: a caller without a valid schedule gets one
+    whenever a quick pass finds it, even past a tiny time limit (as `replan.repair` does)."""
+    try:
+        return quick_schedule(problem)
+    except GreedyStuckError:
+        return None
 
 
 def greedy_result(problem: Problem, start: Start, began: float) -> Result:
