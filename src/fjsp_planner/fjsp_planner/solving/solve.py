@@ -1,6 +1,7 @@
 """One entry point for every backend, returning the solver-neutral `Result`: `solve` checks
 its arguments, finds the start every backend shares (`start`) and picks the backend."""
 
+import dataclasses
 import time
 
 from fjsp_planner.model.limits import MAX_WORKERS
@@ -8,6 +9,7 @@ from fjsp_planner.model.problem import Problem
 from fjsp_planner.model.schedule import Result, Schedule
 from fjsp_planner.solving import portfolio, tabu
 from fjsp_planner.solving.classic import solve_classic
+from fjsp_planner.solving.compact import left_shifted
 from fjsp_planner.solving.cpsat import solve_cpsat
 from fjsp_planner.solving.start import find_start, greedy_result, run_from
 
@@ -26,9 +28,10 @@ def solve(problem: Problem, solver: str = 'cpsat', time_limit: float = 10.0, wor
     fewest of its (job, robot) assignments. The greedy schedule bounds the horizon and is
     returned when an exact solver finds nothing in time.
 
-    The backends: `greedy` alone; `mip`, the paper's program; `cpsat`, the CP-SAT model,
-    beside the tabu search on the classic flexible job shop (`classic`) and with the panel
-    bounds on several identical panels (`portfolio`).
+    Every schedule returned is left-shifted (`compact`). The backends: `greedy` alone;
+    `mip`, the paper's program; `cpsat`, the CP-SAT model, beside the tabu search on the
+    classic flexible job shop (`classic`) and with the panel bounds on several identical
+    panels (`portfolio`).
 
     The whole call (greedy, model building, solving, keeping assignments) takes at most
     `time_limit` seconds, plus the solver's reaction time to its own limit (milliseconds),
@@ -47,6 +50,12 @@ def solve(problem: Problem, solver: str = 'cpsat', time_limit: float = 10.0, wor
     began = time.monotonic()
     greedy_time = time_limit if solver == 'greedy' else GREEDY_SHARE * time_limit
     start = find_start(problem, hint, began, greedy_time, time_limit)
+    return _left_shifted(problem, _backend(problem, solver, start, began, time_limit, workers,
+                                           keep, mip_backend, log))
+
+
+def _backend(problem, solver, start, began, time_limit, workers, keep, mip_backend, log
+             ) -> Result:
     if solver == 'greedy':
         return greedy_result(problem, start, began)
     if solver == 'mip':
@@ -64,3 +73,15 @@ def solve(problem: Problem, solver: str = 'cpsat', time_limit: float = 10.0, wor
         return portfolio.solve_panels(problem, start, began, time_limit, workers, keep, log)
     return run_from(problem, start, began, time_limit, lambda left: solve_cpsat(
         problem, left, workers, hint=start.hint, keep=keep, upper_bound=start.best, log=log))
+
+
+def _left_shifted(problem: Problem, result: Result) -> Result:
+    """The result with its schedule left-shifted (`compact.left_shifted`)."""
+    if result.schedule is None:
+        return result
+    shifted = left_shifted(problem, result.schedule)
+    if shifted is result.schedule:
+        return result
+    bound = None if result.lower_bound is None else min(result.lower_bound, shifted.makespan)
+    return dataclasses.replace(result, schedule=shifted, makespan=shifted.makespan,
+                               lower_bound=bound)
