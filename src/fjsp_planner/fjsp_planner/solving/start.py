@@ -10,7 +10,7 @@ from fractions import Fraction
 from fjsp_planner.model.problem import Problem
 from fjsp_planner.model.schedule import Result, Schedule, Status
 from fjsp_planner.model.validate import validate
-from fjsp_planner.solving.bounds.jobs import critical_path_bound
+from fjsp_planner.solving.bounds.fleet import static_bound
 from fjsp_planner.solving.greedy import (
     GreedyOutOfTimeError,
     GreedyStuckError,
@@ -74,12 +74,12 @@ def _quick(problem: Problem) -> Schedule | None:
 
 
 def greedy_result(problem: Problem, start: Start, began: float) -> Result:
-    """The greedy schedule as a result, bounded by the critical path."""
+    """The greedy schedule as a result, bounded by the static bound."""
     elapsed = time.monotonic() - began
     if start.greedy is None:
         return Result(Status.UNKNOWN, None, None, elapsed, None, 'greedy',
                       notes=start.notes or ('greedy scheduling got stuck; try an exact solver',))
-    return Result(Status.FEASIBLE, start.greedy.makespan, critical_path_bound(problem), elapsed,
+    return Result(Status.FEASIBLE, start.greedy.makespan, static_bound(problem), elapsed,
                   start.greedy, 'greedy', first_solution_seconds=elapsed)
 
 
@@ -93,7 +93,7 @@ def run_from(problem: Problem, start: Start, began: float, time_limit: float,
     if result.schedule is None and best is not None and result.status != Status.INFEASIBLE:
         elapsed = time.monotonic() - began
         which = 'greedy schedule' if best is start.greedy else 'starting schedule'
-        return Result(Status.FEASIBLE, best.makespan, critical_path_bound(problem), elapsed,
+        return Result(Status.FEASIBLE, best.makespan, static_bound(problem), elapsed,
                       best, 'greedy' if best is start.greedy else 'hint',
                       first_solution_seconds=setup, best_solution_seconds=setup,
                       notes=start.notes + result.notes + (
@@ -105,13 +105,14 @@ def run_from(problem: Problem, start: Start, began: float, time_limit: float,
 
 def _count_from(problem: Problem, result: Result, setup: float) -> Result:
     """The backend's times counted from the call, and its bound no weaker than the
-    critical path (an early-stopped search may not have reached even that)."""
+    static bound (`bounds.fleet.static_bound`), which an early-stopped search may not have
+    reached."""
     def shifted(seconds):
         return None if seconds is None else seconds + setup
 
     bound, status = result.lower_bound, result.status
     if bound is not None:
-        path = critical_path_bound(problem)
+        path = static_bound(problem)
         bound = min(max(bound, path), result.makespan)
         if path >= result.makespan:
             status = Status.OPTIMAL
