@@ -7,7 +7,7 @@ import time
 from fjsp_planner.model.limits import MAX_WORKERS
 from fjsp_planner.model.problem import Problem
 from fjsp_planner.model.schedule import Result, Schedule
-from fjsp_planner.solving import portfolio, tabu
+from fjsp_planner.solving import large, portfolio, tabu
 from fjsp_planner.solving.classic import solve_classic
 from fjsp_planner.solving.compact import left_shifted
 from fjsp_planner.solving.cpsat import solve_cpsat
@@ -30,8 +30,9 @@ def solve(problem: Problem, solver: str = 'cpsat', time_limit: float = 10.0, wor
 
     Every schedule returned is left-shifted (`compact`). The backends: `greedy` alone;
     `mip`, the paper's program; `cpsat`, the CP-SAT model, beside the tabu search on the
-    classic flexible job shop (`classic`) and with the panel bounds on several identical
-    panels (`portfolio`).
+    classic flexible job shop (`classic`), with the panel bounds on several identical
+    panels (`portfolio`), and randomised greedy passes where the CP-SAT routing model would
+    be too large (`large`).
 
     The whole call (greedy, model building, solving, keeping assignments) takes at most
     `time_limit` seconds, plus the solver's reaction time to its own limit (milliseconds),
@@ -65,6 +66,8 @@ def _backend(problem, solver, start, began, time_limit, workers, keep, mip_backe
             problem, left, backend=mip_backend, workers=workers, hint=start.best, log=log))
         return portfolio.with_panel_bounds(problem, result, None) if portfolio.applies(
             problem) else result
+    if not large.fits_cpsat(problem):
+        return large.solve_large(problem, start, began, time_limit)
     if start.hint is None and keep is None and start.greedy is not None and tabu.applies(
             problem):
         return solve_classic(problem, start.greedy, began, time_limit, workers, start.notes,
@@ -76,8 +79,9 @@ def _backend(problem, solver, start, began, time_limit, workers, keep, mip_backe
 
 
 def _left_shifted(problem: Problem, result: Result) -> Result:
-    """The result with its schedule left-shifted (`compact.left_shifted`)."""
-    if result.schedule is None:
+    """The result with its schedule left-shifted (`compact.left_shifted`); greedy schedules
+    are by construction."""
+    if result.schedule is None or result.solver == 'greedy':
         return result
     shifted = left_shifted(problem, result.schedule)
     if shifted is result.schedule:
