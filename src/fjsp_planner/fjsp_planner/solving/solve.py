@@ -7,7 +7,7 @@ import time
 from fjsp_planner.model.limits import MAX_WORKERS
 from fjsp_planner.model.problem import Problem
 from fjsp_planner.model.schedule import Result, Schedule
-from fjsp_planner.solving import large, portfolio, tabu
+from fjsp_planner.solving import large, portfolio, routed, tabu
 from fjsp_planner.solving.classic import solve_classic
 from fjsp_planner.solving.compact import left_shifted
 from fjsp_planner.solving.cpsat import solve_cpsat
@@ -31,8 +31,8 @@ def solve(problem: Problem, solver: str = 'cpsat', time_limit: float = 10.0, wor
     Every schedule returned is left-shifted (`compact`). The backends: `greedy` alone;
     `mip`, the paper's program; `cpsat`, the CP-SAT model, beside the tabu search on the
     classic flexible job shop (`classic`), with the panel bounds on several identical
-    panels (`portfolio`), and randomised greedy passes where the CP-SAT routing model would
-    be too large (`large`).
+    panels (`portfolio`), beside the local search on other routed problems (`routed`), and
+    randomised greedy passes where the CP-SAT routing model would be too large (`large`).
 
     The whole call (greedy, model building, solving, keeping assignments) takes at most
     `time_limit` seconds, plus the solver's reaction time to its own limit (milliseconds),
@@ -74,6 +74,8 @@ def _backend(problem, solver, start, began, time_limit, workers, keep, mip_backe
                              log)
     if portfolio.applies(problem):
         return portfolio.solve_panels(problem, start, began, time_limit, workers, keep, log)
+    if routed.applies(problem, start, keep):
+        return routed.solve_routed(problem, start, began, time_limit, workers, log)
     return run_from(problem, start, began, time_limit, lambda left: solve_cpsat(
         problem, left, workers, hint=start.hint, keep=keep, upper_bound=start.best, log=log))
 
