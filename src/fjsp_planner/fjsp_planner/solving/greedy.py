@@ -38,10 +38,10 @@ class Breadth:
 
 
 BREADTH = Breadth(jobs=None, staffings=4, robots=8)
-"""Measured on 1-30 panels: weighing fewer jobs made 10 and 30 panels 35-50 % longer; trying
-more than 4 staffings changed no makespan and took 2.3x as long."""
+"""Every placeable job weighed: weighing fewer made many-panel schedules much longer, while
+more staffings than 4 changed no makespan and cost time."""
 QUICK = Breadth(jobs=4, staffings=2, robots=3)
-"""For when a full pass does not fit the time left (30 panels: 7.8 s full, 0.3 s quick)."""
+"""For when a full pass does not fit the time left: a fraction of its time on many jobs."""
 FULL_PASS_SHARE = 0.5
 """Share of the time to a deadline a full first pass may take before a quick one replaces it."""
 
@@ -210,8 +210,8 @@ class _State:
 
     def candidates(self, name, ready, forced=None):
         """(end, start, plan, robots) for the `breadth.staffings` best ways to staff the job,
-        best first, in floating point: ranking in exact Fractions made a 30-panel pass take
-        half a minute. `place` recomputes the chosen staffing's times exactly."""
+        best first, in floating point: ranking in exact Fractions made a pass on many jobs
+        many times slower. `place` recomputes the chosen staffing's times exactly."""
         job = self.problem.job(name)
         forced = forced or {}
         free_robots = [r for r in self.free

@@ -18,7 +18,7 @@ class LeastDistances:
     a time, each computed once (Dijkstra on a dense graph).
 
     The search runs on integers (every entry times their common denominator): sums of
-    Fractions made the all-pairs search on 5 panels (60 places) most of a bound's time."""
+    Fractions would make the all-pairs search most of a bound's time."""
 
     def __init__(self, matrix):
         self._scale = math.lcm(*(d.denominator for row in matrix for d in row
@@ -136,8 +136,7 @@ def panel_paths(problem: Problem) -> dict[bool, dict[tuple[str, str], Fraction]]
                                 for k, first in enumerate(copies)
                                 for m, second in enumerate(copies) if k != m), detour)
                 for i in indices for j in indices}
-        # The least over x and z, taken one at a time: n^3 steps, not n^4 (a 2-panel problem
-        # of 75 jobs a panel would spend half a minute here).
+        # The least over x and z, taken one at a time: n^3 steps, not n^4.
         to_other = {(i, z): min(inside[i, x] + step[x, z] for x in indices)
                     for i in indices for z in indices}
         across = {(i, j): min(to_other[i, z] + inside[z, j] for z in indices)

@@ -46,22 +46,22 @@ least duration that stands for all their robot sets (weaker, still a lower bound
 MAX_GRID = 1000
 MAX_JOBS = 150
 """Problems of more jobs get no panel machine bound: building the relaxation alone takes
-longer than its share of a usual limit (50 panels of the paper, 600 jobs: 20-40 s), and
-from 3 panels on the panel load bound proves more in the time."""
+longer than its share of a usual limit, and on many panels the panel load bound proves more
+in the time."""
 EVERY_JOB_LIMIT = 30
 """Problems of at most this many jobs keep every job in the relaxation, which CP-SAT's
-default search proves on 2 panels of the paper (24 jobs) in about 2 s. On larger ones it
-proves less in the time than the relaxation of the heavy jobs and those of limited robots
-alone (3 panels in 6 s: 109 against 124, 5 panels 166 against 198), which they keep."""
+default search proves on 2 panels of the paper within seconds. On larger ones it proves
+less in the time than the relaxation of the heavy jobs and those of limited robots alone,
+which they keep."""
 SMALL = 20
 """Relaxations of the heavy and limited jobs alone of at most this many jobs are left to
-CP-SAT's default search, which proves such a relaxation of 2 panels of the paper (18 jobs)
-in 2-4 s; on larger ones its bound stays near the linear relaxation's, and
-BOUND_SUBSOLVERS do better. Relaxations of every job are left to the default search."""
+CP-SAT's default search, which proves them within seconds; on larger ones its bound stays
+near the linear relaxation's, and BOUND_SUBSOLVERS do better. Relaxations of every job are
+left to the default search."""
 BOUND_SUBSOLVERS = ('objective_lb_search', 'default_lp')
 """A worker that asks for relaxed schedules shorter than the proven bound and raises the
-bound when there are none, beside the default one: in 6 s on 2 workers, 3 panels 126 1/3
-and 5 panels 177-196 from run to run (default alone: about 107 and 165)."""
+bound when there are none, beside the default one: on 3 and 5 panels it proves much more
+in the same time than the default search alone."""
 
 
 def panel_machine_bound(problem: Problem, incumbent: Fraction, time_limit: float,

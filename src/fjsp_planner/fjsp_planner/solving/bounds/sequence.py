@@ -65,9 +65,8 @@ It forgets lags between jobs whose ends it does not keep, the ways of robots of 
 their last heavy jobs, and which robot of a set does what. Every schedule shorter than U is
 one of these orders, so the search's least value, or the least value still open (or let
 go, `MAX_OPEN`) when its time runs out, bounds every schedule shorter than U, and min(bound,
-U) bounds all. CP-SAT's
-model of a similar relaxation (`machine_bound`), which knows no panel's place,
-proves about 200 on 5 panels of the paper in minutes.
+U) bounds all. CP-SAT's model of a similar relaxation (`machine`), which knows no panel's
+place, proves less.
 """
 
 import heapq
@@ -98,9 +97,8 @@ clear of: the paper's Assembler does three in a panel it helps without a heavy j
 between (`Ac`, `Jd`, `Ad`)."""
 MAX_OPEN = 320_000
 """When this many orders are open, the quarter of highest value is let go (about 430 MB in
-all with what the search has closed; 5 panels of the paper reach it in about 10 s): the
-bound then rises no further than the least of them, 261 1/6 on 5 panels of the paper after
-two minutes."""
+all with what the search has closed): the bound then rises no further than the least of
+them."""
 
 
 def panel_sequence_bound(problem: Problem, incumbent: Fraction, time_limit: float,
