@@ -9,7 +9,7 @@ from fjsp_planner.model.schedule import Result, Schedule, Status
 from fjsp_planner.model.validate import validate
 from fjsp_planner.solving import tabu
 from fjsp_planner.solving.beside import CpsatBeside
-from fjsp_planner.solving.bounds.fleet import static_bound
+from fjsp_planner.solving.bounds.jobs import critical_path_bound
 
 HANDOFF_SHARE = 0.5
 """Share of the time limit after which CP-SAT, if behind, restarts from the tabu search's
@@ -49,7 +49,8 @@ def solve_classic(problem: Problem, greedy: Schedule, began: float, time_limit: 
             best_at = run.started + (result.best_solution_seconds or result.solve_seconds)
     bound = max((r.lower_bound for r in results if r.lower_bound is not None),
                 default=Fraction(0))
-    bound = min(max(bound, static_bound(problem)), best.makespan)
+    # The fleet bounds see no more than CP-SAT here and would take their time from the search.
+    bound = min(max(bound, critical_path_bound(problem)), best.makespan)
     if any(r.status == Status.INFEASIBLE for r in results):
         raise RuntimeError('CP-SAT found a problem infeasible that has a valid schedule')
     return Result(Status.OPTIMAL if bound >= best.makespan else Status.FEASIBLE,

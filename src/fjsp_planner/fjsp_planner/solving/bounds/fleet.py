@@ -62,7 +62,10 @@ class _Facts:
                                       for k in range(len(job.plans))) for job in p.jobs}
         self.able = {r: {q for q in self.fastest_op if p.duration(r, q) is not None}
                      for r in self.robots}
+        self.able_by_op = {q: frozenset(r for r in self.robots if q in self.able[r])
+                           for q in self.fastest_op}
         self.heads, self.tails = self._heads_and_tails()
+        self.readiness = {}
 
     def arrival(self, robot: str, location: str) -> Fraction:
         """Earliest time the robot can be at `location`."""
@@ -98,15 +101,21 @@ class _Facts:
 
     def needed(self, group: frozenset, job) -> list[tuple[int, Fraction]]:
         """Per plan: (robots of `group` it needs at least, its fastest duration)."""
-        others = [r for r in self.robots if r not in group]
-        return [(len(plan) - max_staffed(self.problem, plan, others),
-                 self.plan_length[job.name, k]) for k, plan in enumerate(job.plans)]
+        found = []
+        for k, plan in enumerate(job.plans):
+            if len(plan) == 1:
+                # One operation: needed from G exactly when no other robot can do it.
+                count = int(self.able_by_op[plan[0]] <= group)
+            else:
+                others = [r for r in self.robots if r not in group]
+                count = len(plan) - max_staffed(self.problem, plan, others)
+            found.append((count, self.plan_length[job.name, k]))
+        return found
 
     def groups(self) -> list[frozenset]:
         p = self.problem
         found = {frozenset(self.robots)}
-        found.update(frozenset(r for r in self.robots if q in self.able[r])
-                     for q in self.fastest_op)
+        found.update(self.able_by_op.values())
         found.update(frozenset(r.name for r in p.robots if r.type == kind)
                      for kind in {r.type for r in p.robots})
         return sorted(found, key=sorted)
@@ -126,10 +135,15 @@ class _Facts:
     def ready(self, robot: str) -> Fraction:
         """Earliest time the robot can be at a job it could work on (its release time if
         there is none)."""
-        p = self.problem
-        reach = [self.arrival(robot, job.location) for job in p.jobs
-                 if any(self.able[robot] & set(plan) for plan in job.plans)]
-        return min(reach, default=p.robot(robot).release_time)
+        found = self.readiness.get(robot)
+        if found is None:
+            p = self.problem
+            places = {job.location for job in p.jobs
+                      if any(self.able[robot].intersection(plan) for plan in job.plans)}
+            found = self.readiness[robot] = min(
+                (self.arrival(robot, place) for place in places),
+                default=p.robot(robot).release_time)
+        return found
 
     def robot_bound(self) -> Fraction:
         p = self.problem
