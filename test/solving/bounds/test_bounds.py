@@ -21,6 +21,7 @@ from fjsp_planner.model.schedule import Status
 from fjsp_planner.model.validate import validate
 from fjsp_planner.solving.bounds import panel as bounds
 from fjsp_planner.solving.bounds import sequence as sequence_bound
+from fjsp_planner.solving.bounds.jobs import critical_path_bound
 from fjsp_planner.solving.bounds.load import panel_load_bound
 from fjsp_planner.solving.bounds.machine import MAX_JOBS, panel_machine_bound
 from fjsp_planner.solving.bounds.sequence import MAX_PANELS, panel_sequence_bound
@@ -75,7 +76,7 @@ def test_decomposition_bounds_never_exceed_the_optimum(two_panels_optimum):
     panel = solve(alone, time_limit=10)
     assert panel.status == Status.OPTIMAL
     assert panel.makespan == 9 <= two_panels_optimum
-    assert bounds.critical_path_bound(problem) == 3
+    assert critical_path_bound(problem) == 3
 
 
 def test_clique_bound_by_hand(two_panels_optimum):
@@ -344,7 +345,7 @@ def test_every_bound_stays_below_mip_proven_optima(seed, optimum):
             ('sequence', panel_sequence_bound(problem, incumbent, 30)),
             ('energy', bounds.panel_energy_bound(problem, incumbent)),
             ('clique', bounds.panel_clique_bound(problem, incumbent)),
-            ('critical path', bounds.critical_path_bound(problem))]:
+            ('critical path', critical_path_bound(problem))]:
         assert found is None or found <= optimum, name
     assert panel_machine_bound(problem, incumbent, 30) is not None
 

@@ -41,7 +41,7 @@ from fjsp_planner.model.problem import (
 )
 from fjsp_planner.model.schedule import JobAssignment, Result, Schedule, Status
 from fjsp_planner.model.validate import validate
-from fjsp_planner.solving.bounds.panel import critical_path_bound
+from fjsp_planner.solving.bounds.jobs import critical_path_bound
 from fjsp_planner.solving.greedy import (
     GreedyOutOfTimeError,
     GreedyStuckError,
@@ -203,8 +203,11 @@ def repair(problem: Problem, previous: Schedule, state: ExecutionState,
     if residual.problem is None:
         return Replan(residual, None, [])
     starts = _starts(residual.problem, previous, began + time_limit / 2)
+    # With a start in hand, the greedy pass must not outlast the limit (`solve` waits for a
+    # quick pass only when it has no valid schedule at all).
     result = solve(residual.problem, solver='greedy',
-                   time_limit=max(0.05, began + time_limit - time.monotonic()))
+                   time_limit=max(0.05, began + time_limit - time.monotonic()),
+                   hint=starts[0] if starts else None)
     holding = {a for a, _, _ in residual.problem.holding if a in residual.problem.fixed}
     if result.schedule is None and not starts and holding:
         residual = residual_problem(problem, state, previous, release=holding)

@@ -28,6 +28,7 @@ from fjsp_planner.model.limits import shown
 from fjsp_planner.model.problem import Problem
 from fjsp_planner.model.schedule import JobAssignment, Schedule
 from fjsp_planner.model.validate import validate
+from fjsp_planner.solving.bounds.geometry import location_distance
 
 
 class Ignored(StrEnum):
@@ -613,27 +614,9 @@ def relaxed_distances(problem: Problem, executed: Schedule) -> dict:
                 legs.add((where, here))
             where, free = here, a.end
     distances = dict(problem.distances)
-    nearest = {}
     for a, b in legs:
-        if a not in nearest:
-            nearest[a] = _shortest_distances(problem, a)
-        distances[a, b] = distances[b, a] = nearest[a][b]
+        distances[a, b] = distances[b, a] = location_distance(problem, a, b)
     return distances
-
-
-def _shortest_distances(problem: Problem, source: str) -> dict[str, Fraction]:
-    """Dijkstra over the complete graph of locations (distances need not be metric)."""
-    places = problem.locations()
-    best = {place: problem.distance(source, place) for place in places}
-    todo = set(places) - {source}
-    while todo:
-        nearest = min(todo, key=best.__getitem__)
-        todo.remove(nearest)
-        for place in todo:
-            via = best[nearest] + problem.distance(nearest, place)
-            if via < best[place]:
-                best[place] = via
-    return best
 
 
 def _time_ok(value) -> bool:

@@ -3,9 +3,10 @@
 The solvers work on integers: CP-SAT scales every time onto a grid and sums them into a
 horizon, so a duration of 1e300 or a speed of 1e-300 overflows its 64-bit arithmetic, and a
 decimal with a huge exponent makes `Fraction` itself compute a number with a billion digits.
-Sizes matter as much: the routing part of the CP-SAT model has one arc per robot and ordered
-pair of jobs it could do, and N panels make N^2 distance entries, so an innocent
-`--panels 100000` would exhaust the machine's memory. Every reader of user input (YAML
+Sizes matter as much: N panels make N^2 distance entries, so an innocent `--panels 100000`
+would exhaust the machine's memory. (The CP-SAT routing model, with one arc per robot and
+ordered pair of jobs it could do, is built only where it fits; larger problems are scheduled
+by greedy passes, see `solving/large.py`.) Every reader of user input (YAML
 scenarios, `.fjs` files, command-line overrides) refuses, naming the item, what lies outside
 these bounds; docs/scenario-format.md ("Limits") explains the figures.
 """
@@ -36,8 +37,6 @@ MAX_OPERATION_TYPES = 1000
 """A `.fjs` file makes one operation type per benchmark operation, so as many as jobs."""
 MAX_ARCS = 10_000
 """Precedence arcs, holding arcs, time overrides: each list."""
-MAX_ROUTING_ARCS = 1_500_000
-"""Sum over robots of (jobs it could take part in)^2: the paper's fleet at 50 panels."""
 MAX_NAME_LENGTH = 100
 MAX_FILE_BYTES = 4 * 2**20
 MAX_WORKERS = 64
@@ -150,20 +149,11 @@ def read_input_file(path, kind: str) -> str:
 def scale_problems(robots, robot_types, jobs, distances, locomote, time_overrides,
                    panels: int = 1, shift: Fraction = Fraction(0)) -> list[str]:
     """What makes the problem, repeated over `panels`, too large for the solvers: too many
-    jobs, too large a routing model, or a travel time beyond MAX_TIME. Takes the parts of a
+    jobs, or a travel time beyond MAX_TIME. Takes the parts of a
     `Problem` so that it can be checked before one is built; ids that do not resolve are
     skipped (they are reported elsewhere)."""
     problems = count_problem('jobs' + (f' ({len(jobs)} x {panels} panels)' if panels > 1
                                        else ''), len(jobs) * panels, MAX_JOBS)
-    arcs = 0
-    for robot in robots:
-        able = {q for q in robot_types.get(robot.type, {})}
-        able.update(q for r, q in time_overrides if r == robot.name)
-        arcs += (panels * sum(any(able.intersection(plan) for plan in job.plans)
-                              for job in jobs)) ** 2
-    problems += count_problem(
-        'routing arcs (sum over robots of the square of the number of jobs it could do)',
-        arcs, MAX_ROUTING_ARCS, 'the solver builds one per robot and ordered pair of jobs')
     if locomote is None or not distances:
         return problems
     (a, b), farthest = max(distances.items(), key=lambda item: item[1])

@@ -1,7 +1,14 @@
 """Solving a `Problem` for the least makespan (docs/solver.md). No ROS.
 
-- `solve`: the one entry point, `solve(problem, time_limit, ...) -> Result`; it picks the
-  backends and runs them;
+- `solve`: the one entry point, `solve(problem, time_limit, ...) -> Result`; it only picks
+  the backend;
+- `start`: what every backend starts from and falls back on (greedy schedule, hint);
+- `portfolio`: several identical panels: CP-SAT beside the panel bounds;
+- `classic`: the classic flexible job shop: CP-SAT beside the tabu search;
+- `routed`: multi-robot jobs with travel: CP-SAT beside the local search (`local`);
+- `large`: problems too large for the CP-SAT routing model: randomised greedy passes;
+- `compact`: left-shifting a schedule (every job as early as its robots allow);
+- `beside`: work run in threads beside the main search;
 - `cpsat/`: the CP-SAT model and search, split by concern;
 - `greedy`: list scheduling, a valid schedule in milliseconds (horizons, hints, fallback);
 - `panels`: a schedule for identical panels stitched from one-panel optima;

@@ -2,14 +2,16 @@
 
 Jobs are placed one at a time, each at the assignment (plan and robots) that completes it
 earliest. A holding arc (j, j', q) is placed as one block: j, then j' straight away with j's
-type-q robots, so no other job can come between them on the holders' routes.
+type-q robots, so no other job can come between them on the holders' routes. When no block
+can be placed (two arcs whose held jobs each wait for the other's jig job), j is placed
+alone and its holders are kept for j', which is placed once its other predecessors are; a
+pass that gets stuck so comes back to its last such choice and tries another.
 
 `guided_schedule` places jobs instead in the order and with the staffing of a schedule to
 follow (a plan a failure broke, or copies of one-panel optima), wherever that is still
 possible, so that what worked before is kept and only exact times are recomputed.
 """
 
-import itertools
 import random
 import time
 from dataclasses import dataclass
@@ -19,6 +21,8 @@ from fjsp_planner.model.problem import Problem
 from fjsp_planner.model.schedule import JobAssignment, Schedule
 
 MAX_CANDIDATES_PER_PLAN = 2000
+MAX_BACKTRACKS = 1000
+"""Partial placements of holding chains undone in one pass before it gives up as stuck."""
 
 
 @dataclass(frozen=True)
@@ -29,13 +33,15 @@ class Breadth:
     """Placeable jobs weighed, those ready soonest first (None: all)."""
     staffings: int
     """Staffings of a jig job tried, best first, when placing it with the jobs it holds into."""
+    robots: int
+    """Robots weighed per operation of a plan, those that could end it soonest first."""
 
 
-BREADTH = Breadth(jobs=None, staffings=4)
-"""Measured on 1-30 panels: weighing fewer jobs made 10 and 30 panels 35-50 % longer; trying
-more than 4 staffings changed no makespan and took 2.3x as long."""
-QUICK = Breadth(jobs=4, staffings=2)
-"""For when a full pass does not fit the time left (30 panels: 7.8 s full, 0.3 s quick)."""
+BREADTH = Breadth(jobs=None, staffings=4, robots=8)
+"""Every placeable job weighed: weighing fewer made many-panel schedules much longer, while
+more staffings than 4 changed no makespan and cost time."""
+QUICK = Breadth(jobs=4, staffings=2, robots=3)
+"""For when a full pass does not fit the time left: a fraction of its time on many jobs."""
 FULL_PASS_SHARE = 0.5
 """Share of the time to a deadline a full first pass may take before a quick one replaces it."""
 
@@ -80,6 +86,25 @@ def greedy_schedule(problem: Problem, passes: int = 16, seed: int = 0,
     return best
 
 
+def sampled_schedule(problem: Problem, deadline: float, seed: int = 0,
+                     breadth: Breadth = QUICK) -> Schedule | None:
+    """The best of randomised passes of `breadth` run one after another until `deadline`
+    (time.monotonic()), or None if none finished: more samples of a large problem than full
+    passes would give."""
+    rng = random.Random(seed)
+    best = None
+    while time.monotonic() < deadline:
+        try:
+            schedule = _one_pass(problem, rng, deadline, breadth)
+        except GreedyOutOfTimeError:
+            break
+        except GreedyStuckError:
+            continue
+        if best is None or schedule.makespan < best.makespan:
+            best = schedule
+    return best
+
+
 def serial_upper_bound(problem: Problem) -> Fraction:
     """Makespan of doing the jobs one after another, each with its slowest robots."""
     robots = [r.name for r in problem.robots]
@@ -103,6 +128,12 @@ class _State:
         self.problem = problem
         self.breadth = breadth
         self.free = {r.name: r.release_time for r in problem.robots}
+        self.free_f = {r: float(t) for r, t in self.free.items()}
+        self.legs_f = {}
+        """(robot, from, to) -> travel time in floating point, for ranking staffings."""
+        self.ready = {}
+        """job -> when its predecessors are all done, once they are all placed."""
+        self.ready_f = {}
         self.where = {r.name: r.start_location for r in problem.robots}
         self.reserved = {}
         self.jobs = {}
@@ -120,7 +151,7 @@ class _State:
     def copy(self):
         other = _State.__new__(_State)
         other.__dict__.update(self.__dict__)
-        for name in ('free', 'where', 'reserved', 'jobs'):
+        for name in ('free', 'free_f', 'where', 'reserved', 'jobs', 'ready', 'ready_f'):
             setattr(other, name, dict(getattr(self, name)))
         other.sequences = {r: list(s) for r, s in self.sequences.items()}
         return other
@@ -129,6 +160,17 @@ class _State:
         here = self.where[robot]
         leg = Fraction(0) if here is None else self.problem.travel(robot, here, location)
         return self.free[robot] + leg
+
+    def arrival_f(self, robot, location) -> float:
+        """`arrival` in floating point, without Fraction arithmetic."""
+        here = self.where[robot]
+        if here is None or here == location:
+            return self.free_f[robot]
+        key = (robot, here, location)
+        leg = self.legs_f.get(key)
+        if leg is None:
+            leg = self.legs_f[key] = float(self.problem.travel(robot, here, location))
+        return self.free_f[robot] + leg
 
     def place(self, name, plan, robots):
         """Start the job as soon as it is ready and its robots have arrived, exactly."""
@@ -142,6 +184,7 @@ class _State:
         for r in assignment.robots:
             # max: a running (fixed) job may end before its robot's release time.
             self.free[r] = max(self.free[r], assignment.end)
+            self.free_f[r] = float(self.free[r])
             self.where[r] = self.problem.job(assignment.job).location
             self.sequences[r].append(assignment.job)
             if self.reserved.get(r) == assignment.job:
@@ -154,23 +197,28 @@ class _State:
 
     def ready_at(self, name):
         """When every predecessor is done, or None while one is still unplaced."""
-        ends = []
-        for a in self.predecessors[name]:
-            if a not in self.jobs:
-                return None
-            ends.append(self.jobs[a].end)
-        return max(ends, default=Fraction(0))
+        found = self.ready.get(name)
+        if found is None:
+            ends = []
+            for a in self.predecessors[name]:
+                if a not in self.jobs:
+                    return None
+                ends.append(self.jobs[a].end)
+            found = self.ready[name] = max(ends, default=Fraction(0))
+            self.ready_f[name] = float(found)
+        return found
 
     def candidates(self, name, ready, forced=None):
         """(end, start, plan, robots) for the `breadth.staffings` best ways to staff the job,
-        best first, in floating point: ranking in exact Fractions made a 30-panel pass take
-        half a minute. `place` recomputes the chosen staffing's times exactly."""
+        best first, in floating point: ranking in exact Fractions made a pass on many jobs
+        many times slower. `place` recomputes the chosen staffing's times exactly."""
         job = self.problem.job(name)
         forced = forced or {}
         free_robots = [r for r in self.free
                        if r not in forced and self.reserved.get(r, name) == name]
-        arrive_f = {r: float(self.arrival(r, job.location)) for r in (*free_robots, *forced)}
-        ready_f = float(ready)
+        arrive_f = {r: self.arrival_f(r, job.location) for r in (*free_robots, *forced)}
+        ready_f = max([float(ready)] + [arrive_f[r] for r in forced])
+        forced_longest = max((self.duration_f(r, q) for r, q in forced.items()), default=0.0)
         out = []
         for plan_index, plan in enumerate(job.plans):
             remaining = list(plan)
@@ -179,18 +227,21 @@ class _State:
                     break
                 remaining.remove(q)
             else:
-                count = 0
-                for chosen in itertools.permutations(free_robots, len(remaining)):
+                remaining.sort()
+                able = {}
+                for q in set(remaining):
+                    found = [(r, arrive_f[r], d) for r in free_robots
+                             if (d := self.duration_f(r, q)) is not None]
+                    if len(found) > self.breadth.robots:
+                        found.sort(key=lambda o: max(ready_f, o[1]) + o[2])
+                        found = found[:self.breadth.robots + remaining.count(q) - 1]
+                    able[q] = found
+                found = []
+                _staff(remaining, able, 0, 0, [], ready_f, forced_longest, found)
+                for start, end, chosen in found:
                     robots = dict(forced)
                     robots.update(zip(chosen, remaining, strict=True))
-                    times = [self.duration_f(r, q) for r, q in robots.items()]
-                    if None in times:
-                        continue
-                    start = max(ready_f, *(arrive_f[r] for r in robots))
-                    out.append((start + max(times), start, plan_index, robots))
-                    count += 1
-                    if count >= MAX_CANDIDATES_PER_PLAN:
-                        break
+                    out.append((end, start, plan_index, robots))
         out.sort(key=lambda c: (c[0], c[1]))
         return out[:self.breadth.staffings]
 
@@ -200,6 +251,28 @@ class _State:
             time = self.problem.duration(robot, q)
             self.durations[key] = None if time is None else float(time)
         return self.durations[key]
+
+
+def _staff(operations, able, k, first, chosen, start, longest, found):
+    """Append to `found` (start, end, robots) for each way to give `operations[k:]` (sorted)
+    distinct robots not in `chosen`, up to MAX_CANDIDATES_PER_PLAN: equal operations take
+    robots in the order of `able` (robot, arrival, duration), so each set is found once."""
+    if k == len(operations):
+        found.append((start, start + longest, tuple(chosen)))
+        return
+    options = able[operations[k]]
+    for index in range(first, len(options)):
+        if len(found) >= MAX_CANDIDATES_PER_PLAN:
+            return
+        robot, arrival, duration = options[index]
+        if robot in chosen:
+            continue
+        chosen.append(robot)
+        following = index + 1 if k + 1 < len(operations) and operations[k + 1] == operations[
+            k] else 0
+        _staff(operations, able, k + 1, following, chosen, max(start, arrival),
+               max(longest, duration), found)
+        chosen.pop()
 
 
 def _first_pass(problem: Problem, deadline) -> Schedule:
@@ -233,30 +306,52 @@ def _one_pass(problem: Problem, rng, deadline=None, breadth=None, guide=None) ->
         state.commit(JobAssignment(name, fixed.plan, fixed.start, fixed.end,
                                    dict(fixed.robots)))
     pending = [j.name for j in problem.jobs if j.name not in problem.fixed]
+    backtrack, tries = [], 0
     while pending:
         if deadline is not None and time.monotonic() > deadline:
             raise GreedyOutOfTimeError
-        options = []
-        for name in _by_readiness(state, pending):
-            if name in state.held_from and state.held_from[name][0] not in state.jobs:
-                continue
-            block = _block_option(state, name)
-            if block is not None:
-                options.append(block)
-                if state.breadth.jobs is not None and len(options) == state.breadth.jobs:
-                    break
-        if not options:
-            raise GreedyStuckError('greedy scheduling found no job it can place next among '
-                              + ', '.join(sorted(pending)))
-        options.sort(key=lambda o: (_guide_order(state, o[1][0][0]), o[0]))
-        if rng is not None and len(options) > 1 and rng.random() < 0.3:
-            choice = options[rng.randrange(min(3, len(options)))]
+        options = _options(state, pending)
+        if options:
+            options.sort(key=lambda o: (_guide_order(state, o[1][0][0]), o[0]))
+            if rng is not None and len(options) > 1 and rng.random() < 0.3:
+                choice = options[rng.randrange(min(3, len(options)))]
+            else:
+                choice = options[0]
         else:
+            # Each partial placement keeps holders from other jobs: the first tried may
+            # leave a job no robots, so the others are kept to come back to.
+            options = sorted(_options(state, pending, partial=True),
+                             key=lambda o: (_guide_order(state, o[1][0][0]), o[0]))
+            if not options:
+                if not backtrack or tries >= MAX_BACKTRACKS:
+                    raise GreedyStuckError('greedy scheduling found no job it can place next '
+                                           'among ' + ', '.join(sorted(pending)))
+                state, pending, options = backtrack.pop()
+                tries += 1
             choice = options[0]
+            if len(options) > 1:
+                backtrack.append((state.copy(), list(pending), options[1:]))
         for name, plan, robots in choice[1]:
             state.place(name, plan, robots)
             pending.remove(name)
     return Schedule(state.jobs, {r: tuple(s) for r, s in state.sequences.items()})
+
+
+def _options(state: _State, pending, partial=False) -> list:
+    """(score, [placements]) for the jobs that can be placed next, with the jobs they hold
+    into; with `partial`, a holding chain whose held job still waits for another job is
+    offered up to that job, its holders kept for it (two arcs whose held jobs each wait for
+    the other's jig job can only be placed so)."""
+    options = []
+    for name in _by_readiness(state, pending):
+        if name in state.held_from and state.held_from[name][0] not in state.jobs:
+            continue
+        block = _block_option(state, name, partial)
+        if block is not None:
+            options.append(block)
+            if state.breadth.jobs is not None and len(options) == state.breadth.jobs:
+                break
+    return options
 
 
 def _guide_order(state: _State, name) -> float:
@@ -289,22 +384,26 @@ def _by_readiness(state: _State, pending):
     problem's order (which keeps a panel's jobs together)."""
     ready = []
     for name in pending:
-        at = state.ready_at(name)
-        if at is not None:
-            ready.append((at, state.order[name], name))
+        if state.ready_at(name) is not None:
+            ready.append((state.ready_f[name], state.order[name], name))
     ready.sort()
     return [name for _, _, name in ready]
 
 
-def _block_option(state: _State, name):
-    """(score, [placements]) for the job and the jobs it holds into, or None if not ready."""
+def _block_option(state: _State, name, partial=False):
+    """(score, [placements]) for the job and the jobs it holds into, or None if not ready;
+    with `partial`, for the job and those it holds into up to the first that waits for a job
+    outside the chain."""
     chain = [name]
     while chain[-1] in state.holds_into:
         chain.append(state.holds_into[chain[-1]][0])
-    for member in chain[1:]:
+    for index, member in enumerate(chain[1:], 1):
         others = [a for a in state.predecessors[member] if a not in chain]
         if any(a not in state.jobs for a in others):
-            return None
+            if not partial:
+                return None
+            chain = chain[:index]
+            break
     ready = state.ready_at(name)
     if ready is None:
         return None

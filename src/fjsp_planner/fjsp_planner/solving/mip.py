@@ -42,8 +42,9 @@ from fractions import Fraction
 from ortools.linear_solver import pywraplp
 
 from fjsp_planner.model.problem import Problem
-from fjsp_planner.model.schedule import JobAssignment, Result, Schedule, Status
+from fjsp_planner.model.schedule import Result, Schedule, Status
 from fjsp_planner.model.validate import validate
+from fjsp_planner.solving.compact import earliest_schedule
 
 BACKENDS = ('SCIP', 'HIGHS')
 MAX_GRID = 10 ** 6
@@ -373,60 +374,3 @@ class _Model:
         # Only zero-length jobs can close a cycle of arcs; order by the solver's times then.
         return tuple(sorted(mine, key=lambda j: (round(self.start[j].solution_value(), 6),
                                                  round(self.end[j].solution_value(), 6))))
-
-
-def earliest_schedule(problem: Problem, plan, robots, sequences) -> Schedule:
-    """The earliest-start schedule, in exact time, of given plans, robots and robot sequences.
-
-    A job starts when its predecessors are complete and each of its robots has finished its
-    previous job and travelled over (or, for its first job, has come from its start location)
-    and is released; it completes when its slowest operation ends. Fixed jobs keep their times.
-    """
-    p = problem
-    blockers = {j.name: set() for j in p.jobs}
-    for a, b in p.precedence:
-        blockers[b].add(a)
-    previous = {}
-    for m, sequence in sequences.items():
-        for a, b in zip(sequence, sequence[1:], strict=False):
-            blockers[b].add(a)
-            previous[m, b] = a
-    start, end = {}, {}
-    order = _topological(blockers)
-    for j in order:
-        if j in p.fixed:
-            start[j], end[j] = p.fixed[j].start, p.fixed[j].end
-            continue
-        here = p.job(j).location
-        times = [end[a] for a in p.predecessors(j)]
-        for m in robots[j]:
-            before = previous.get((m, j))
-            if before is None:
-                r = p.robot(m)
-                leg = p.travel(m, r.start_location, here) if r.start_location else 0
-                times.append(r.release_time + leg)
-            else:
-                times.append(end[before] + p.travel(m, p.job(before).location, here))
-                times.append(p.robot(m).release_time)
-        start[j] = max(times, default=Fraction(0))
-        end[j] = start[j] + max(p.duration(m, q) for m, q in robots[j].items())
-    jobs = {j: JobAssignment(j, plan[j], start[j], end[j], dict(robots[j])) for j in order}
-    return Schedule(jobs, {m: tuple(seq) for m, seq in sequences.items()})
-
-
-def _topological(blockers) -> list[str]:
-    waiting = {j: set(b) for j, b in blockers.items()}
-    ready = sorted(j for j, b in waiting.items() if not b)
-    order = []
-    while ready:
-        j = ready.pop()
-        order.append(j)
-        for other, b in waiting.items():
-            if j in b:
-                b.discard(j)
-                if not b:
-                    ready.append(other)
-    if len(order) != len(waiting):
-        stuck = sorted(set(waiting) - set(order))
-        raise RuntimeError(f'robot sequences and precedence form a cycle among {stuck}')
-    return order

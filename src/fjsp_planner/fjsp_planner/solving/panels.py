@@ -4,7 +4,7 @@ robot, then each further panel by the robots that can move between panels, one a
 On the paper's panels the Assembler needs 200 units to cross, so a good schedule does the
 first panel with all four robots (32) and the rest with LSMS and the MARCs alone (55 1/6
 each), moving on between panels. CP-SAT on the whole 5-panel model reaches such schedules only
-slowly; the one-panel problems solve in about a second. The copies' optimal schedules, shifted
+slowly; the one-panel problems solve quickly. The copies' optimal schedules, shifted
 one after another, only say in which order and by whom jobs are done: `guided_schedule` turns
 that into exact times, travel included, so the result is a valid schedule of the whole
 problem, used as the search's starting point when it beats the greedy one.
@@ -17,6 +17,7 @@ from fjsp_planner.model.problem import Problem
 from fjsp_planner.model.schedule import JobAssignment, Schedule
 from fjsp_planner.model.validate import validate
 from fjsp_planner.solving.bounds import panel as bounds
+from fjsp_planner.solving.bounds.geometry import crossing_cost
 from fjsp_planner.solving.greedy import GreedyOutOfTimeError, GreedyStuckError, guided_schedule
 
 
@@ -38,7 +39,7 @@ def stitched_schedule(problem: Problem, incumbent: Fraction, time_limit: float, 
     if full.schedule is None or alone.schedule is None:
         return None, alone.lower_bound
     guide, offset = {}, Fraction(0)
-    cross = max(bounds.crossing_cost(problem, r.name) for r in unhelped.robots)
+    cross = max(crossing_cost(problem, r.name) for r in unhelped.robots)
     for k, names in enumerate(problem.panels):
         copy = full.schedule if k == 0 else alone.schedule
         base = problem.panels[0]

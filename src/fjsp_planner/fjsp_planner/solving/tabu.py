@@ -1,8 +1,8 @@
 """Tabu search for single-robot jobs without travel: the classic flexible job shop.
 
-CP-SAT proves small classic instances at once but, on 2 cores, ends 3-15 % above the best
-known on the larger ones within 10 s (Brandimarte mk10, Dauzere-Peres, Hurink la21): its
-search spends most of the time in the LP and in repairing its own neighbourhoods. The
+CP-SAT proves small classic instances at once but, on 2 cores, ends above the best known on
+the larger ones within seconds (Brandimarte mk10, Dauzere-Peres, Hurink la21): its search
+spends most of the time in the LP and in repairing its own neighbourhoods. The
 critical-path neighbourhood of Mastrolilli and Gambardella ("Effective neighbourhood
 functions for the flexible job shop problem", 2000) improves such schedules thousands of
 times a second, and CP-SAT, hinted with the result, then closes what is left or proves it.

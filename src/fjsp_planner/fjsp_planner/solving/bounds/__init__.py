@@ -1,7 +1,12 @@
 """Lower bounds on the makespan, each sound for any schedule (docs/solver.md, "Bounds").
 
-- `panel`: the critical path, and the panel decomposition bounds for identical panels
-  (energy, clique), with the geometry the others share (least travel, panel limits);
+- `geometry`: least distances along the distance table and the least travel they force
+  (one shortest-path routine for every bound and the mission tracker);
+- `jobs`: staffings, precedence order, heads and tails, and the critical path bound;
+- `fleet`: bounds for any scenario from what the fleet must do: chains from the robots'
+  arrival, energy over capability groups, a robot alone with its travel;
+- `panel`: the panel decomposition bounds for identical panels (energy, clique) and the
+  panel limits of robots slow to move between panels;
 - `machine`: the "panel machine" relaxation CP-SAT solves to optimality;
 - `load`: the "panel load" bound from what each robot must do and travel;
 - `sequence`: the "panel sequence" search, which knows where each panel lies.

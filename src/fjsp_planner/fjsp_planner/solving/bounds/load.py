@@ -19,8 +19,8 @@ so moving between two places of a panel costs at least the least distance betwee
   (a schedule that visits more is no shorter than the known one, U).
 
 CP-SAT chooses every job's staffing (the robots, at the least duration of each set) to
-minimise the largest such sum: no sequencing, so even 10 panels (120 jobs) are proven or
-nearly in seconds, where the panel machine bound, which sequences, falls behind. What it
+minimise the largest such sum: no sequencing, so even many panels are proven or nearly in
+seconds, where the panel machine bound, which sequences, falls behind. What it
 misses is idle time: robots waiting for predecessors or for the other robots of a job. One
 kind is counted in a second solve, from the first one's bound: a *cut job*, one that every
 other job of its panel precedes or follows, runs alone in its panel, so a robot that works
@@ -36,18 +36,15 @@ from fractions import Fraction
 from ortools.sat.python import cp_model
 
 from fjsp_planner.model.problem import Problem
+from fjsp_planner.solving.bounds.geometry import panel_distance, travel_factor
+from fjsp_planner.solving.bounds.jobs import heads_and_tails, staffings
 from fjsp_planner.solving.bounds.machine import BOUND_SUBSOLVERS
-from fjsp_planner.solving.bounds.panel import (
-    _heads_and_tails,
-    _panel_distance,
-    _staffings,
-    panel_limits,
-)
+from fjsp_planner.solving.bounds.panel import panel_limits
 
 MAX_GRID = 1000
 MAX_CHOICES = 20_000
-"""Staffing literals beyond which building the model alone would take seconds (the paper's
-10 panels have 580); large fleets and many panels go without this bound."""
+"""Staffing literals beyond which building the model alone would take seconds; large fleets
+and many panels go without this bound."""
 MIN_SECOND_SOLVE = 0.2
 """Seconds below which the model with waits is not tried: it proves nothing more so soon."""
 
@@ -58,9 +55,9 @@ def panel_load_bound(problem: Problem, incumbent: Fraction, time_limit: float,
     panels, running jobs, jobs outside the panels) or CP-SAT proves nothing in `time_limit`
     seconds.
 
-    The loads alone are proven within a second or two even on 10 panels; with the waits the
-    model is proven on 2 and 3 panels but not on 5 or 10 within seconds, so it is solved
-    second, from what the loads alone prove, for the time left."""
+    The loads alone are proven quickly even on many panels; with the waits the model is
+    proven on few panels only, so it is solved second, from what the loads alone prove, for
+    the time left."""
     panels = problem.panels
     if len(panels) < 2 or problem.fixed or sum(map(len, panels)) != len(problem.jobs):
         return None
@@ -84,8 +81,8 @@ def _solve(problem: Problem, incumbent: Fraction, choices, time_limit: float, wo
     `_cut_jobs`) the waits around them count too, from `floor` (what is proven without)."""
     panels = problem.panels
     places, between_places = _places(problem)
-    between_panels = _panel_distance(problem)
-    factors = {r.name: _travel_factor(problem, r.name) for r in problem.robots}
+    between_panels = panel_distance(problem)
+    factors = {r.name: travel_factor(problem, r.name) for r in problem.robots}
     values = [d for found in choices.values() for d, _ in found]
     values += [r.release_time for r in problem.robots]
     values += [f * d for f in factors.values() for d in (between_places, between_panels)]
@@ -140,7 +137,7 @@ def _solve(problem: Problem, incumbent: Fraction, choices, time_limit: float, wo
             m.add(p <= limits[r])
     if limits and _interchangeable(problem, choices, places):
         # Any panel order gives the same loads: let the slowest limited robot's panels be
-        # the first ones (on 10 panels, 469 proven in 2 s instead of 447.5 in 6 s).
+        # the first ones, which spares the search every reordering of them.
         slowest = max(limits, key=factors.get)
         for k in range(len(panels) - 1):
             m.add(visits[slowest][k] >= visits[slowest][k + 1])
@@ -242,7 +239,7 @@ def _choices(problem: Problem, incumbent: Fraction):
     """job -> [(least duration, robot set)]: a set is kept only if no smaller set is as
     fast (it would load more robots for nothing), nor does it end the job at or after
     `incumbent` whatever else happens (the fastest is kept regardless)."""
-    heads, tails = _heads_and_tails(problem)
+    heads, tails = heads_and_tails(problem)
     robots = sorted(r.name for r in problem.robots)
     out, known = {}, {}
     for job in problem.jobs:
@@ -258,20 +255,13 @@ def _choices(problem: Problem, incumbent: Fraction):
 def _fitting(problem, plans, robots, around, incumbent):
     fastest = {}
     for plan in plans:
-        for staffing in _staffings(problem, plan, robots):
+        for staffing in staffings(problem, plan, robots):
             key = frozenset(r for r, _ in staffing)
             length = max(problem.duration(r, q) for r, q in staffing)
             fastest[key] = min(length, fastest.get(key, length))
     found = sorted((d, tuple(sorted(s))) for s, d in fastest.items()
                    if not any(o < s and fastest[o] <= d for o in fastest))
     return [(d, s) for d, s in found if around + d < incumbent] or found[:1]
-
-
-def _travel_factor(problem: Problem, robot: str) -> Fraction:
-    if problem.locomote is None:
-        return Fraction(0)
-    r = problem.robot(robot)
-    return problem.robot_types[r.type][problem.locomote] / r.speed
 
 
 def _places(problem: Problem):

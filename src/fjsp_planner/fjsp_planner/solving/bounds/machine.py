@@ -15,7 +15,7 @@ one job at a time. The relaxation keeps every job of every panel, with:
 - for two jobs whose choices share a robot, that the one ends before the other starts,
   apart by the shared robot's least travel from the one's place to the other's, in one
   panel or from one panel to another, whatever the robot does in between
-  (`bounds.least_travel`; the slowest of the shared robots, for the cheapest pair of robot
+  (`geometry.least_travel`; the slowest of the shared robots, for the cheapest pair of robot
   sets);
 - for a jig job whose robots all hold into another job, that those robots start nothing
   else between the jig job's start and the held job's end;
@@ -36,12 +36,9 @@ from fractions import Fraction
 from ortools.sat.python import cp_model
 
 from fjsp_planner.model.problem import Problem
-from fjsp_planner.solving.bounds.panel import (
-    _staffings,
-    _topological,
-    least_travel,
-    panel_limits,
-)
+from fjsp_planner.solving.bounds.geometry import least_travel
+from fjsp_planner.solving.bounds.jobs import StaffingChoice, staffings, topological
+from fjsp_planner.solving.bounds.panel import panel_limits
 
 MAX_CHOICES = 8
 """Staffing choices kept apart per job and kind of choice; beyond, they merge into one at the
@@ -49,30 +46,22 @@ least duration that stands for all their robot sets (weaker, still a lower bound
 MAX_GRID = 1000
 MAX_JOBS = 150
 """Problems of more jobs get no panel machine bound: building the relaxation alone takes
-longer than its share of a usual limit (50 panels of the paper, 600 jobs: 20-40 s), and
-from 3 panels on the panel load bound proves more in the time."""
+longer than its share of a usual limit, and on many panels the panel load bound proves more
+in the time."""
 EVERY_JOB_LIMIT = 30
 """Problems of at most this many jobs keep every job in the relaxation, which CP-SAT's
-default search proves on 2 panels of the paper (24 jobs) in about 2 s. On larger ones it
-proves less in the time than the relaxation of the heavy jobs and those of limited robots
-alone (3 panels in 6 s: 109 against 124, 5 panels 166 against 198), which they keep."""
+default search proves on 2 panels of the paper within seconds. On larger ones it proves
+less in the time than the relaxation of the heavy jobs and those of limited robots alone,
+which they keep."""
 SMALL = 20
 """Relaxations of the heavy and limited jobs alone of at most this many jobs are left to
-CP-SAT's default search, which proves such a relaxation of 2 panels of the paper (18 jobs)
-in 2-4 s; on larger ones its bound stays near the linear relaxation's, and
-BOUND_SUBSOLVERS do better. Relaxations of every job are left to the default search."""
+CP-SAT's default search, which proves them within seconds; on larger ones its bound stays
+near the linear relaxation's, and BOUND_SUBSOLVERS do better. Relaxations of every job are
+left to the default search."""
 BOUND_SUBSOLVERS = ('objective_lb_search', 'default_lp')
 """A worker that asks for relaxed schedules shorter than the proven bound and raises the
-bound when there are none, beside the default one: in 6 s on 2 workers, 3 panels 126 1/3
-and 5 panels 177-196 from run to run (default alone: about 107 and 165)."""
-
-
-class _Choice:
-    """A way to staff a job: its least duration, the robot sets it stands for, whether it
-    needs more than half of G, and the limited robots all its sets have."""
-
-    def __init__(self, duration, sets, heavy, limited):
-        self.duration, self.sets, self.heavy, self.limited = duration, sets, heavy, limited
+bound when there are none, beside the default one: on 3 and 5 panels it proves much more
+in the same time than the default search alone."""
 
 
 def panel_machine_bound(problem: Problem, incumbent: Fraction, time_limit: float,
@@ -136,7 +125,7 @@ def panel_shape(problem: Problem, allowed, group, limited):
     for name in problem.panels[0]:
         fastest = {}
         for plan in problem.job(name).plans:
-            for staffing in _staffings(problem, plan, allowed):
+            for staffing in staffings(problem, plan, allowed):
                 robots = frozenset(r for r, _ in staffing)
                 length = max(problem.duration(r, q) for r, q in staffing)
                 fastest[robots] = min(length, fastest.get(robots, length))
@@ -148,7 +137,7 @@ def panel_shape(problem: Problem, allowed, group, limited):
     names = set(problem.panels[0])
     inside = [(a, b) for a, b in problem.precedence if a in names and b in names]
     inside += [(a, b) for a, b, _ in problem.holding if a in names and b in names]
-    order = [n for n in _topological(problem) if n in names]
+    order = [n for n in topological(problem) if n in names]
     successors = {n: [b for a, b in inside if a == n] for n in names}
     predecessors = {n: [a for a, b in inside if b == n] for n in names}
     release = min(r.release_time for r in problem.robots if r.name in set(allowed))
@@ -189,7 +178,7 @@ def panel_shape(problem: Problem, allowed, group, limited):
     return jobs, lags, holds
 
 
-def _choices(fastest, group, limited) -> list[_Choice]:
+def _choices(fastest, group, limited) -> list[StaffingChoice]:
     """Choices from robot set -> least duration: a set that contains another as fast with
     the same heaviness and limited robots is dropped (its crossings are no cheaper); past
     MAX_CHOICES of a kind, they merge."""
@@ -205,7 +194,7 @@ def _choices(fastest, group, limited) -> list[_Choice]:
             kept = [(min(length for length, _ in kept), tuple(r for _, r in kept))]
         else:
             kept = [(length, (robots,)) for length, robots in kept]
-        out += [_Choice(length, sets_, heavy, mine) for length, sets_ in kept]
+        out += [StaffingChoice(length, sets_, heavy, mine) for length, sets_ in kept]
     return out
 
 

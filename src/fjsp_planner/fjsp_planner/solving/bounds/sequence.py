@@ -65,9 +65,8 @@ It forgets lags between jobs whose ends it does not keep, the ways of robots of 
 their last heavy jobs, and which robot of a set does what. Every schedule shorter than U is
 one of these orders, so the search's least value, or the least value still open (or let
 go, `MAX_OPEN`) when its time runs out, bounds every schedule shorter than U, and min(bound,
-U) bounds all. CP-SAT's
-model of a similar relaxation (`machine_bound`), which knows no panel's place,
-proves about 200 on 5 panels of the paper in minutes.
+U) bounds all. CP-SAT's model of a similar relaxation (`machine`), which knows no panel's
+place, proves less.
 """
 
 import heapq
@@ -76,9 +75,11 @@ import math
 import threading
 import time
 from collections.abc import Callable
+from dataclasses import replace
 from fractions import Fraction
 
 from fjsp_planner.model.problem import Problem
+from fjsp_planner.solving.bounds.geometry import least_job_travel
 from fjsp_planner.solving.bounds.machine import panel_shape, within_incumbent
 from fjsp_planner.solving.bounds.panel import panel_limits
 
@@ -96,9 +97,8 @@ clear of: the paper's Assembler does three in a panel it helps without a heavy j
 between (`Ac`, `Jd`, `Ad`)."""
 MAX_OPEN = 320_000
 """When this many orders are open, the quarter of highest value is let go (about 430 MB in
-all with what the search has closed; 5 panels of the paper reach it in about 10 s): the
-bound then rises no further than the least of them, 261 1/6 on 5 panels of the paper after
-two minutes."""
+all with what the search has closed): the bound then rises no further than the least of
+them."""
 
 
 def panel_sequence_bound(problem: Problem, incumbent: Fraction, time_limit: float,
@@ -188,11 +188,10 @@ class _Search:
         self.limited = limited
         self.panels = len(problem.panels)
         names = problem.panels[0]
-        paths = _Paths(problem)
         kept = sorted({job[0] for shape in (bare, helped) for job in shape[0]})
         copies = [(k, n, problem.panels[k][names.index(n)]) for k in range(self.panels)
                   for n in kept]
-        travel = {(r.name, k, a, m, b): paths.travel(r.name, x, y)
+        travel = {(r.name, k, a, m, b): least_job_travel(problem, r.name, x, y)
                   for r in problem.robots for k, a, x in copies for m, b, y in copies}
         values = [v for shape in (bare, helped) for _, head, tail, choices in shape[0]
                   for v in (head, tail, *(c.duration for c in choices))]
@@ -806,7 +805,7 @@ class _Shape:
         self.names = [name for name, *_ in jobs]
         self.heads = [ticks(head) for _, head, _, _ in jobs]
         self.tails = [ticks(tail) for _, _, tail, _ in jobs]
-        self.choices = [[_Choice(ticks(c.duration), c.sets, c.heavy, c.limited)
+        self.choices = [[replace(c, duration=ticks(c.duration))
                          for c in choices] for *_, choices in jobs]
         index = {name: k for k, name in enumerate(self.names)}
         self.before = [sum(1 << index[a] for (a, b) in lags if b == name)
@@ -824,13 +823,6 @@ class _Shape:
         self.least_tail = [min((self.tails[j] for j in left), default=0)
                            for left in heavy_left]
         self.rest = {}
-
-
-class _Choice:
-    def __init__(self, duration, sets, heavy, limited):
-        self.duration, self.sets, self.heavy, self.limited = duration, sets, heavy, limited
-        self.always = frozenset.intersection(*map(frozenset, sets))
-        self.anyone = frozenset.union(*map(frozenset, sets))
 
 
 def _pending(shape):
@@ -873,41 +865,3 @@ def _rest_costs(shape, switch):
                 best = found if best is None else min(best, found)
             rest[done, last] = best or 0
     return rest
-
-
-class _Paths:
-    """Least distance between places along the distance table (which need not obey the
-    triangle inequality), times a robot's travel factor."""
-
-    def __init__(self, problem: Problem):
-        self.problem = problem
-        places = problem.locations()
-        self.index = {p: k for k, p in enumerate(places)}
-        # On integers (every distance times their common denominator): Fraction sums made
-        # this loop most of the bound's time on 5 panels (60 places).
-        scale = math.lcm(*(d.denominator for d in problem.distances.values()))
-        far = [[None if (a, b) not in problem.distances and a != b else
-                int(problem.distances.get((a, b), 0) * scale) for b in places] for a in places]
-        for via in range(len(places)):
-            row_via = far[via]
-            for i in range(len(places)):
-                to_via = far[i][via]
-                if to_via is None:
-                    continue
-                row = far[i]
-                for j in range(len(places)):
-                    onward = row_via[j]
-                    if onward is not None and (row[j] is None or to_via + onward < row[j]):
-                        row[j] = to_via + onward
-        self.paths = [[None if d is None else Fraction(d, scale) for d in row] for row in far]
-
-    def travel(self, robot, first, second) -> Fraction:
-        """`first`, `second`: job names."""
-        problem = self.problem
-        if problem.locomote is None:
-            return Fraction(0)
-        r = problem.robot(robot)
-        distance = self.paths[self.index[problem.job(first).location]][
-            self.index[problem.job(second).location]]
-        return ((distance or Fraction(0)) * problem.robot_types[r.type][problem.locomote]
-                / r.speed)

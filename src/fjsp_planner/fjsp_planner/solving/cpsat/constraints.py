@@ -10,7 +10,7 @@ from fractions import Fraction
 
 from fjsp_planner.model.problem import Problem
 from fjsp_planner.solving.bounds import panel as bounds
-from fjsp_planner.solving.bounds.panel import crossing_cost
+from fjsp_planner.solving.bounds.geometry import crossing_cost
 from fjsp_planner.solving.cpsat.grid import TimeGrid
 from fjsp_planner.solving.cpsat.variables import JobVariables, RouteVariables, check
 
@@ -83,17 +83,53 @@ def holding(m, problem: Problem, jobs: JobVariables, route: RouteVariables):
                 m.add(in_a == 0)
 
 
-def makespan_covers_work(m, problem: Problem, grid: TimeGrid, jobs: JobVariables, makespan):
-    """A robot's release time plus the jobs it does fit before the makespan.
+def makespan_covers_work(m, problem: Problem, grid: TimeGrid, jobs: JobVariables, makespan,
+                         legs):
+    """A robot's release time, the jobs it does and one leg into each place it works at fit
+    before the makespan.
 
-    Implied by no-overlap, but as one linear inequality per robot it reaches the LP, which
-    otherwise spreads the work thin over fractional assignments."""
+    Implied by no-overlap and the routes, but as one linear inequality per robot it reaches
+    the LP, which otherwise spreads the work thin over fractional assignments. A robot is
+    busy for the whole job: at least its own operation and the plan's fastest duration (each
+    operation by its fastest robot). A robot goes straight from one job to the next, so it
+    enters each place it works at other than its start location at least once, by a leg no
+    shorter than the least from any other place (a robot that may start anywhere enters its
+    first place for free). With running jobs, where a robot already is at a job's place,
+    only the work counts."""
+    fastest = {}
+    for job in problem.jobs:
+        for index, plan in enumerate(job.plans):
+            fastest[job.name, index] = max(
+                min(t for r in jobs.robots if (t := problem.duration(r, q)) is not None)
+                for q in plan)
+    places = sorted({job.location for job in problem.jobs})
     for robot in problem.robots:
         r = robot.name
-        work = [jobs.longest[j.name, r] for j in problem.jobs
-                if (j.name, r) in jobs.longest and j.name not in problem.fixed]
-        if work:
-            m.add(sum(work) + grid.ticks(robot.release_time) <= makespan)
+        mine = [j.name for j in problem.jobs
+                if (j.name, r) in jobs.does and j.name not in problem.fixed]
+        if not mine:
+            continue
+        work = sum(lit * grid.ticks(max(problem.duration(r, q), fastest[j, index]))
+                   for j in mine for index, q, lit in jobs.does[j, r])
+        entries = []
+        if problem.locomote is not None and not problem.fixed:
+            for place in sorted({problem.job(j).location for j in mine}):
+                if place == robot.start_location:
+                    continue
+                sources = [a for a in places if a != place]
+                if robot.start_location is not None:
+                    sources.append(robot.start_location)
+                leg = min((grid.ticks(legs[r, a, place]) for a in sources if a != place),
+                          default=0)
+                if leg > 0:
+                    visit = m.new_bool_var(f'visits_{place}_{r}')
+                    m.add_max_equality(visit, [jobs.on_job[j, r] for j in mine
+                                               if problem.job(j).location == place])
+                    entries.append((visit, leg))
+        travel = sum(visit * leg for visit, leg in entries)
+        if robot.start_location is None and entries:
+            travel -= max(leg for _, leg in entries)
+        m.add(work + travel + grid.ticks(robot.release_time) <= makespan)
 
 
 class PanelVariables:

@@ -49,7 +49,7 @@ class CpsatModel:
         constraints.routes(m, p, grid, self.jobs, self.routes, self.legs, deadline, clock)
         constraints.holding(m, p, self.jobs, self.routes)
         self.makespan = objective.makespan(m, self.jobs, self.horizon)
-        constraints.makespan_covers_work(m, p, grid, self.jobs, self.makespan)
+        constraints.makespan_covers_work(m, p, grid, self.jobs, self.makespan, self.legs)
         self.panels = constraints.panels(m, p, grid, self.jobs, self.makespan,
                                          incumbent if grid.exact else None)
         check(deadline, clock)

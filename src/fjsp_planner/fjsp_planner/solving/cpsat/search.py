@@ -59,8 +59,7 @@ def solve_cpsat(problem: Problem, time_limit=10.0, workers=2, hint: Schedule | N
     try:
         model = CpsatModel(problem, upper_bound, deadline)
         # Without routes (classic FJSP) CP-SAT finds better schedules from scratch than from
-        # the greedy one: hinted with it, mk10 ended at 383 instead of 224 and Dauzere-Peres
-        # 05a at 3223 instead of 2539 in 10 s. The greedy schedule then only sets the horizon.
+        # the greedy one, which then only sets the horizon.
         start = hint if hint is not None or not model.routes.routed else upper_bound
         if start is not None:
             model.add_hint(start, deadline)
@@ -110,8 +109,8 @@ def run(model, time_limit, workers, log, handle=None, scale=1, reader=None):
     # CP-SAT otherwise replaces the process's SIGINT handler, so a node that solved once
     # dies of Ctrl-C instead of shutting down cleanly.
     solver.parameters.catch_sigint_signal = False
-    # Presolve probing took the whole budget at 5 panels before any search (and slowed the
-    # 1-panel proof 2x), while it did not tighten the bound measurably at 2 panels.
+    # Presolve probing took the whole budget on many panels before any search, and slowed
+    # the one-panel proof, without tightening the bound.
     solver.parameters.cp_model_probing_level = 0
     recorder = _SolutionTimes(handle, scale, reader)
     if handle is not None and not handle.attach(solver):

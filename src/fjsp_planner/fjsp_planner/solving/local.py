@@ -1,0 +1,292 @@
+"""A local search for multi-robot jobs with travel (docs/solver.md, "Local search").
+
+A schedule is kept as its decisions: each job's plan and robots, each robot's order of jobs;
+its times are the earliest those decisions allow (`compact.earliest_schedule`), computed
+here in floating point for speed and exactly for the schedule returned. Each step looks at
+the jobs of a critical path (the chain of jobs, each started by the end of the one before
+it on a robot or by precedence, that ends at the makespan) and tries, for each:
+
+- giving one of its operations to another able robot, put into that robot's order where the
+  job's current start falls (or one place earlier or later);
+- swapping it with the job before or after it on one of its robots, or moving it on that
+  robot's route next to a job at the same place (the legs around it vanish);
+
+and makes the best move that shortens the makespan, or that keeps it and shortens the sum
+of job ends (which frees robots earlier); with none, it shakes the best schedule by a few
+random moves. Jobs of holding arcs keep their holders and their order (the holders go
+directly from one to the other); running (fixed) jobs are never moved. A move whose orders
+and precedence close a cycle is refused.
+"""
+
+import random
+import time
+
+from fjsp_planner.model.problem import Problem
+from fjsp_planner.model.schedule import Schedule
+from fjsp_planner.model.validate import validate
+from fjsp_planner.solving.compact import earliest_schedule
+
+STALL_STEPS = 30
+"""Steps without a better schedule before the search shakes the best one."""
+SHAKE_MOVES = 3
+
+
+class _Instance:
+    """The problem in floating point, by index."""
+
+    def __init__(self, problem: Problem):
+        self.problem = p = problem
+        self.names = [j.name for j in p.jobs]
+        self.index = {name: k for k, name in enumerate(self.names)}
+        self.robots = [r.name for r in p.robots]
+        self.location = [p.job(name).location for name in self.names]
+        self.predecessors = [[] for _ in self.names]
+        for a, b in p.precedence:
+            self.predecessors[self.index[b]].append(self.index[a])
+        self.fixed = {self.index[name]: (float(f.start), float(f.end))
+                      for name, f in p.fixed.items()}
+        self.held_types = {}
+        """job -> operation types a holding arc ties to its robots."""
+        for a, b, q in p.holding:
+            for name in (a, b):
+                self.held_types.setdefault(self.index[name], set()).add(q)
+        self.holding = [(self.index[a], self.index[b], q) for a, b, q in p.holding]
+        self.duration = {}
+        self.release = {r.name: float(r.release_time) for r in p.robots}
+        self.start_location = {r.name: r.start_location for r in p.robots}
+        self.legs = {}
+
+    def time(self, robot, q) -> float | None:
+        key = (robot, q)
+        if key not in self.duration:
+            found = self.problem.duration(robot, q)
+            self.duration[key] = None if found is None else float(found)
+        return self.duration[key]
+
+    def leg(self, robot, a, b) -> float:
+        if a is None or a == b:
+            return 0.0
+        key = (robot, a, b)
+        found = self.legs.get(key)
+        if found is None:
+            found = self.legs[key] = float(self.problem.travel(robot, a, b))
+        return found
+
+
+class _Solution:
+    """Plans, robots (job -> {robot: operation type}) and orders (robot -> [job])."""
+
+    def __init__(self, plan, robots, orders):
+        self.plan, self.robots, self.orders = plan, robots, orders
+        self.start = self.end = None
+        self.makespan = self.total = None
+        self.cause = None
+        """job -> the job whose end set its start (None: its robots' release or arrival)."""
+
+    def copy(self):
+        return _Solution(list(self.plan), [dict(r) for r in self.robots],
+                         {r: list(o) for r, o in self.orders.items()})
+
+    def evaluate(self, inst: _Instance) -> bool:
+        """Earliest times; False if the orders and precedence close a cycle."""
+        n = len(inst.names)
+        previous = [dict() for _ in range(n)]
+        waiting = [len(inst.predecessors[j]) for j in range(n)]
+        unblocks = [[] for _ in range(n)]
+        for j in range(n):
+            for a in inst.predecessors[j]:
+                unblocks[a].append(j)
+        for r, order in self.orders.items():
+            for a, b in zip(order, order[1:], strict=False):
+                previous[b][r] = a
+                waiting[b] += 1
+                unblocks[a].append(b)
+        ready = [j for j in range(n) if not waiting[j]]
+        start, end, cause = [0.0] * n, [0.0] * n, [None] * n
+        done = 0
+        while ready:
+            j = ready.pop()
+            done += 1
+            if j in inst.fixed:
+                start[j], end[j] = inst.fixed[j]
+            else:
+                here = inst.location[j]
+                at, by = 0.0, None
+                for a in inst.predecessors[j]:
+                    if end[a] > at:
+                        at, by = end[a], a
+                longest = 0.0
+                for r, q in self.robots[j].items():
+                    before = previous[j].get(r)
+                    if before is None:
+                        there = inst.release[r] + inst.leg(r, inst.start_location[r], here)
+                        if there > at:
+                            at, by = there, None
+                    else:
+                        there = max(end[before] + inst.leg(r, inst.location[before], here),
+                                    inst.release[r])
+                        if there > at:
+                            at, by = there, before
+                    longest = max(longest, inst.time(r, q))
+                start[j], end[j], cause[j] = at, at + longest, by
+            for b in unblocks[j]:
+                waiting[b] -= 1
+                if not waiting[b]:
+                    ready.append(b)
+        if done < n:
+            return False
+        self.start, self.end, self.cause = start, end, cause
+        self.makespan, self.total = max(end, default=0.0), sum(end)
+        return True
+
+    def critical(self) -> list[int]:
+        """The jobs of a critical path, last first."""
+        j = max(range(len(self.end)), key=self.end.__getitem__)
+        path = []
+        while j is not None and j not in path:
+            path.append(j)
+            j = self.cause[j]
+        return path
+
+    def better(self, other) -> bool:
+        return (self.makespan, self.total) < (other.makespan - 1e-9, other.total - 1e-9)
+
+
+def local_search(problem: Problem, start: Schedule, deadline: float, seed: int = 0,
+                 stop=None) -> tuple[Schedule, float]:
+    """The best schedule the search finds from `start` (valid) by `deadline` or until
+    `stop()`, and when it was found (time.monotonic())."""
+    inst = _Instance(problem)
+    current = _from_schedule(inst, start)
+    found_at = time.monotonic()
+    if not current.evaluate(inst):
+        return start, found_at
+    best = current
+    rng = random.Random(seed)
+    stalled = 0
+    while time.monotonic() < deadline and not (stop is not None and stop()):
+        moved = _best_move(inst, current, rng)
+        if moved is None or not moved.better(current):
+            stalled += 1
+            if stalled >= STALL_STEPS:
+                current, stalled = _shaken(inst, best, rng), 0
+            elif moved is None:
+                current, stalled = _shaken(inst, best, rng), 0
+            else:
+                current = moved
+            continue
+        current = moved
+        if current.better(best):
+            best, found_at, stalled = current, time.monotonic(), 0
+    schedule = _to_schedule(inst, best)
+    if schedule.makespan >= start.makespan or validate(problem, schedule):
+        return start, found_at
+    return schedule, found_at
+
+
+def _from_schedule(inst: _Instance, schedule: Schedule) -> _Solution:
+    plan = [schedule.jobs[name].plan for name in inst.names]
+    robots = [dict(schedule.jobs[name].robots) for name in inst.names]
+    orders = {r: [inst.index[j] for j in schedule.sequences.get(r, ())] for r in inst.robots}
+    return _Solution(plan, robots, orders)
+
+
+def _to_schedule(inst: _Instance, solution: _Solution) -> Schedule:
+    names = inst.names
+    return earliest_schedule(
+        inst.problem, {names[j]: solution.plan[j] for j in range(len(names))},
+        {names[j]: solution.robots[j] for j in range(len(names))},
+        {r: [names[j] for j in order] for r, order in solution.orders.items()})
+
+
+def _movable_operations(inst: _Instance, solution: _Solution, j):
+    """(robot, operation type) of job j that a move may give to another robot."""
+    if j in inst.fixed:
+        return []
+    held = inst.held_types.get(j, ())
+    return [(r, q) for r, q in solution.robots[j].items() if q not in held]
+
+
+def _tied(inst: _Instance, j) -> bool:
+    return j in inst.fixed or j in inst.held_types
+
+
+def _best_move(inst: _Instance, current: _Solution, rng):
+    best = None
+    for j in current.critical():
+        for moved in _moves(inst, current, j, rng):
+            if moved.evaluate(inst) and (best is None or moved.better(best)):
+                best = moved
+    return best
+
+
+def _moves(inst: _Instance, current: _Solution, j, rng):
+    """Solutions one move from `current` around job j (not yet evaluated)."""
+    for r, q in _movable_operations(inst, current, j):
+        others = [o for o in inst.robots
+                  if o not in current.robots[j] and inst.time(o, q) is not None]
+        rng.shuffle(others)
+        for other in others[:4]:
+            for shift in (0, -1, 1):
+                moved = current.copy()
+                del moved.robots[j][r]
+                moved.robots[j][other] = q
+                moved.orders[r].remove(j)
+                order = moved.orders[other]
+                place = sum(1 for k in order if current.start[k] < current.start[j]) + shift
+                if 0 <= place <= len(order):
+                    order.insert(place, j)
+                    if _holds_kept(inst, moved, other):
+                        yield moved
+    if _tied(inst, j):
+        return
+    for r in current.robots[j]:
+        order = current.orders[r]
+        k = order.index(j)
+        for other in (k - 1, k + 1):
+            if 0 <= other < len(order) and not _tied(inst, order[other]):
+                moved = current.copy()
+                swapped = moved.orders[r]
+                swapped[k], swapped[other] = swapped[other], swapped[k]
+                yield moved
+        # Next to a job at the same place on the robot's route, the legs around it vanish.
+        here = inst.location[j]
+        rest = order[:k] + order[k + 1:]
+        places = [m for m in range(len(rest) + 1)
+                  if m != k and ((m > 0 and inst.location[rest[m - 1]] == here)
+                                 or (m < len(rest) and inst.location[rest[m]] == here))]
+        rng.shuffle(places)
+        for m in places[:4]:
+            moved = current.copy()
+            moved.orders[r] = rest[:m] + [j] + rest[m:]
+            if _holds_kept(inst, moved, r):
+                yield moved
+
+
+def _holds_kept(inst: _Instance, solution: _Solution, robot) -> bool:
+    """Whether every job the robot holds out of is still directly followed by the job it
+    holds into, in the robot's order."""
+    order = solution.orders[robot]
+    for a, b, q in inst.holding:
+        if solution.robots[a].get(robot) == q:
+            k = order.index(a)
+            if k + 1 >= len(order) or order[k + 1] != b:
+                return False
+    return True
+
+
+def _shaken(inst: _Instance, best: _Solution, rng) -> _Solution:
+    """`best` after a few random moves that keep it evaluable."""
+    current = best
+    for _ in range(SHAKE_MOVES):
+        jobs = list(range(len(inst.names)))
+        rng.shuffle(jobs)
+        for j in jobs[:10]:
+            options = list(_moves(inst, current, j, rng))
+            rng.shuffle(options)
+            moved = next((o for o in options if o.evaluate(inst)), None)
+            if moved is not None:
+                current = moved
+                break
+    return current
+

@@ -1,0 +1,49 @@
+"""Multi-robot jobs with travel, beyond the sizes CP-SAT proves at once: CP-SAT and the local
+search side by side, from the start (docs/solver.md, "Local search").
+
+CP-SAT runs in a thread of its own from the start's schedule, for its bound and its own
+improvements; the local search (`local`) runs meanwhile from the same schedule. The shorter
+schedule wins; the bound is CP-SAT's, no weaker than the static bound.
+"""
+
+import time
+
+from fjsp_planner.model.problem import Problem
+from fjsp_planner.model.schedule import Result, Status
+from fjsp_planner.solving.beside import CpsatBeside
+from fjsp_planner.solving.bounds.fleet import static_bound
+from fjsp_planner.solving.local import local_search
+from fjsp_planner.solving.start import Start
+
+MIN_JOBS = 25
+"""Up to this many jobs CP-SAT usually proves the optimum in seconds with both cores."""
+
+
+def applies(problem: Problem, start: Start, keep) -> bool:
+    """Routed problems (travel or holding) of more than MIN_JOBS jobs with a start, and no
+    assignments to keep (the local search does not weigh them)."""
+    routed = problem.locomote is not None or bool(problem.holding)
+    return (routed and keep is None and start.best is not None
+            and len(problem.jobs) > MIN_JOBS)
+
+
+def solve_routed(problem: Problem, start: Start, began: float, time_limit: float,
+                 workers: int, log: bool) -> Result:
+    deadline = began + time_limit
+    first = start.best
+    setup = time.monotonic() - began
+    search = CpsatBeside(problem, deadline, workers, first, start.hint or first, log)
+    best, best_at = local_search(problem, first, deadline, stop=search.done)
+    solver = 'local search' if best is not first else 'greedy'
+    result = search.result()
+    if result.status == Status.INFEASIBLE:
+        raise RuntimeError('CP-SAT found a problem infeasible that has a valid schedule')
+    if result.schedule is not None and result.makespan < best.makespan:
+        best, solver = result.schedule, 'cpsat'
+        best_at = search.started + (result.best_solution_seconds or result.solve_seconds)
+    bound = min(max(result.lower_bound or 0, static_bound(problem)), best.makespan)
+    return Result(Status.OPTIMAL if bound >= best.makespan else Status.FEASIBLE,
+                  best.makespan, bound, time.monotonic() - began, best, solver,
+                  first_solution_seconds=setup, best_solution_seconds=max(best_at - began,
+                                                                          setup),
+                  notes=start.notes + result.notes)

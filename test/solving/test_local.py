@@ -1,0 +1,40 @@
+"""The local search for multi-robot jobs with travel: valid, never worse than its start, and
+it finds the moves a critical path asks for."""
+
+import time
+from fractions import Fraction
+
+from fjsp_planner.model.generator import Shape, random_scenario
+from fjsp_planner.model.problem import Job, Problem, Robot
+from fjsp_planner.model.scenario import parse_scenario
+from fjsp_planner.model.schedule import JobAssignment, Schedule
+from fjsp_planner.model.validate import validate
+from fjsp_planner.solving.greedy import greedy_schedule
+from fjsp_planner.solving.local import local_search
+
+
+def test_jobs_move_from_a_slow_robot_to_a_fast_one():
+    """A welds in 5, B in 1; x then y both on A end at 10. Giving y to B ends at 5, then x
+    too at 2 (B welds both, one after the other), the optimum."""
+    problem = Problem(operation_types={1: 'weld'},
+                      robot_types={'Slow': {1: Fraction(5)}, 'Fast': {1: Fraction(1)}},
+                      robots=(Robot('A', 'Slow'), Robot('B', 'Fast')),
+                      jobs=(Job('x', 'here', ((1,),)), Job('y', 'here', ((1,),))))
+    start = Schedule({'x': JobAssignment('x', 0, Fraction(0), Fraction(5), {'A': 1}),
+                      'y': JobAssignment('y', 0, Fraction(5), Fraction(10), {'A': 1})},
+                     {'A': ('x', 'y'), 'B': ()})
+    assert validate(problem, start) == []
+    found, _ = local_search(problem, start, time.monotonic() + 2)
+    assert validate(problem, found) == []
+    assert found.makespan == 2
+
+
+def test_generated_scenarios_stay_valid_and_no_longer():
+    """Holding arcs, travel and multi-robot jobs: every move keeps the holders' direct legs
+    and precedence, so the result validates and is no longer than the greedy start."""
+    for seed in (1, 2, 3):
+        problem = parse_scenario(random_scenario(seed, Shape(jobs=30, robots=5)))
+        start = greedy_schedule(problem)
+        found, _ = local_search(problem, start, time.monotonic() + 1, seed=seed)
+        assert validate(problem, found) == []
+        assert found.makespan <= start.makespan
