@@ -332,8 +332,9 @@ class PlannerNode(Node):
 
     async def execute_goal(self, handle):
         goal = handle.request
-        if not self.auth.accept(goal, RUN_MISSION_ACTION):
-            return self.reject(handle, ['the goal is not signed with the fleet key'])
+        why = self.auth.refusal(goal, RUN_MISSION_ACTION)
+        if why:
+            return self.reject(handle, [f'refused: {why}'])
         if goal.request_id and self.goal is not None \
                 and goal.request_id == self.goal.request_id:
             return await self.take_over(handle)
@@ -465,9 +466,9 @@ class PlannerNode(Node):
         return answer
 
     def on_cancel(self, request, response):
-        if not self.auth.accept(request, CANCEL_MISSION_SERVICE, service=True):
-            response.success = False
-            response.message = 'refused: the request is not signed with the fleet key'
+        why = self.auth.refusal(request, CANCEL_MISSION_SERVICE, service=True)
+        if why:
+            response.success, response.message = False, f'refused: {why}'
             return response
         mission = self.controller.mission
         if request.mission_id and (mission is None or request.mission_id != mission.id):
@@ -489,8 +490,9 @@ class PlannerNode(Node):
     def on_add_jobs(self, request, response):
         mission = self.controller.mission
         response.success = False
-        if not self.auth.accept(request, ADD_JOBS_SERVICE, service=True):
-            response.message = 'refused: the request is not signed with the fleet key'
+        why = self.auth.refusal(request, ADD_JOBS_SERVICE, service=True)
+        if why:
+            response.message = f'refused: {why}'
             return response
         if mission is None or mission.state.ended:
             response.message = 'no mission is running'
