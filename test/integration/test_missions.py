@@ -96,10 +96,10 @@ def test_successive_missions_on_one_fleet(client, observer):
     assert plans[0].revision == 1
 
 
-def test_goal_during_a_mission_and_broken_goal_are_rejected(client, observer):
+def test_goal_that_will_not_wait_and_broken_goal_are_rejected(client, observer):
     running = client.submit(PAPER)
     with pytest.raises(MissionError, match='one mission per fleet') as busy:
-        client.submit(PAPER)
+        client.submit(PAPER, queue=False)
     assert running.mission_id in str(busy.value)
     broken = {'operation_types': {0: 'weld'}, 'robot_types': {'W': {'weld': 1}},
               'robots': [{'name': 'R1', 'type': 'Welder'}],
