@@ -1,8 +1,10 @@
 """Missions as a service that cannot be confused, over real processes: requests name the
-mission they are for, every client is heard whatever other clients did, and missions sent while
-one runs wait their turn in a queue a restarted planner keeps."""
+mission they are for, every client is heard whatever other clients did, missions sent while
+one runs wait their turn in a queue a restarted planner keeps, and `mission submit --wait`
+gives up once the planner is gone."""
 
 import copy
+import subprocess
 import time
 
 import pytest
@@ -10,6 +12,7 @@ import pytest
 from fjsp_msgs.action import RunMission
 from fjsp_msgs.msg import MissionEvent, MissionStatus
 from fjsp_msgs.srv import CancelMission
+from fjsp_planner.launcher.supervision import find_executable
 from fjsp_planner.missions import MissionClient, MissionError
 from fjsp_planner.model.scenario import load_scenario
 from fjsp_planner.testing import check_executed_timeline, check_jobs_done_once
@@ -224,3 +227,23 @@ def test_a_restarted_planner_keeps_its_queue(fjsp_fleet, tmp_path):
     assert f"mission '{queued.mission_id}' waits in the queue again (position 1)" in log
     check_done_once(load_scenario(PAPER), observer, running.mission_id)
     check_done_once(load_scenario(PAPER, panels=2), observer, queued.mission_id)
+
+
+# --- item I: `mission submit --wait` and a planner that dies -------------------------------
+
+def test_submit_wait_gives_up_with_a_reason_once_the_planner_is_gone(fjsp_fleet):
+    fleet = idle_fleet(fjsp_fleet)
+    submit = subprocess.Popen(
+        [str(find_executable('fjsp_planner', 'mission')), 'submit', str(PAPER), '--wait',
+         '--timeout', '5'], env=fleet.env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+        text=True)
+    try:
+        fleet.wait_for(lambda o: o.status.jobs_done >= 1, 60, 'the mission under way')
+        fleet.kill('planner')
+        out, err = submit.communicate(timeout=60)
+    finally:
+        if submit.poll() is None:
+            submit.kill()
+            submit.communicate()
+    assert submit.returncode == 1, out + err
+    assert 'the planner has said nothing of mission' in err, err

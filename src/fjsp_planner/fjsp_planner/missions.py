@@ -39,6 +39,9 @@ RESEND = 1.0
 """Seconds without an answer after which a request is sent again."""
 SEND_TIMEOUT = 10.0
 """Seconds a request may wait for the client's executor thread to send it."""
+SILENCE = 10.0
+"""Seconds without feedback on a submitted mission after which the planner is taken for gone:
+it gives feedback with every status it publishes (every `status_period`, 0.5 s by default)."""
 RESULT_STATES = ('complete', 'cancelled', 'failed', 'blocked too long', 'rejected')
 """RunMission.Result.STATE_* in order."""
 
@@ -76,9 +79,11 @@ class _Feedback:
         self.first = threading.Event()
         self.mission_id = ''
         self.queue_position = 0
+        self.heard = time.monotonic()
 
     def __call__(self, msg):
         feedback = msg.feedback
+        self.heard = time.monotonic()
         self.mission_id = self.mission_id or feedback.mission_id
         self.queue_position = feedback.queue_position
         self.first.set()
@@ -105,10 +110,24 @@ class MissionHandle:
         it runs."""
         return self._feedback.queue_position
 
-    def result(self, timeout: float | None = None) -> MissionResult:
-        """Wait for the mission to end; MissionError after `timeout` seconds."""
-        if not self._ended.wait(timeout):
-            raise MissionError(f"mission '{self.mission_id}' did not end within {timeout:g} s")
+    def result(self, timeout: float | None = None, silence: float | None = SILENCE
+               ) -> MissionResult:
+        """Wait for the mission to end; MissionError after `timeout` seconds, or once the
+        planner has said nothing of the mission for `silence` seconds (it stopped, or the
+        link to it is down: its result would never come)."""
+        deadline = None if timeout is None else time.monotonic() + timeout
+        while not self._ended.wait(0.2):
+            now = time.monotonic()
+            if deadline is not None and now >= deadline:
+                raise MissionError(f"mission '{self.mission_id}' did not end within "
+                                   f'{timeout:g} s')
+            if silence is not None and now - self._feedback.heard > silence:
+                gone = '' if self._client._action.server_is_ready() else \
+                    f"; no planner serves '{self._client._action_name}' any more"
+                raise MissionError(
+                    f"the planner has said nothing of mission '{self.mission_id}' for "
+                    f'{silence:g} s{gone}: it stopped, or the link to it is down, and the '
+                    "mission's result will not come ('mission status' says what runs now)")
         return _result(self._result.result().result)
 
     def cancel(self, timeout: float = 10.0) -> None:
@@ -261,6 +280,7 @@ class MissionClient:
         goal_handle = accepted.result()
         if not goal_handle.accepted:
             raise MissionError('the planner refused the goal')
+        heard.heard = time.monotonic()
         handle = MissionHandle(self, goal_handle, heard)
         # A mission started or queued names itself in its first feedback; a rejected one
         # ends at once.
@@ -404,7 +424,8 @@ def _parser():
                         help='fail the mission after being blocked this long (s); 0: never')
     submit.add_argument('--wait', action='store_true',
                         help='follow the mission to its end, printing its progress; exit 0 '
-                             'only if it completes')
+                             'only if it completes, 1 as soon as the planner says nothing '
+                             'of it for --timeout seconds')
     submit.add_argument('--no-queue', action='store_true',
                         help='refused if a mission runs, rather than waiting its turn')
     cancel = verbs.add_parser('cancel', help='cancel the running mission, or a queued one')
@@ -473,7 +494,7 @@ def _run(client: MissionClient, args) -> int:
               + (f'queued at position {position}' if position else 'started'), flush=True)
         if not args.wait:
             return 0
-        result = mission.result()
+        result = mission.result(silence=args.timeout)
         print(describe_result(result))
         return 0 if result.complete else 1
     if args.verb == 'cancel':
