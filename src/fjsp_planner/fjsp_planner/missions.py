@@ -298,6 +298,12 @@ class MissionClient:
         else:
             raise MissionError(f'the planner accepted the goal but said nothing of it within '
                                f'{timeout:g} s')
+        # The planner published the status naming a mission it started before its feedback,
+        # on another topic: once it is here, `cancel()` and `add_jobs()` find the mission.
+        while handle.queue_position == 0 and not handle._ended.is_set() \
+                and getattr(self._status, 'mission_id', '') != handle.mission_id \
+                and time.monotonic() < deadline:
+            time.sleep(0.02)
         return handle
 
     def run(self, scenario=None, *, timeout: float | None = None, **goal) -> MissionResult:
