@@ -15,8 +15,8 @@ from fjsp_msgs.srv import CancelMission
 from fjsp_planner.launcher.supervision import find_executable
 from fjsp_planner.missions import MissionClient, MissionError
 from fjsp_planner.model.scenario import load_scenario
-from fjsp_planner.testing import check_executed_timeline, check_jobs_done_once
 
+from mission_checks import check_done_once, of_mission
 from repo_paths import PAPER
 
 ROBOTS = ('Assembler', 'LSMS', 'MARC1', 'MARC2')
@@ -38,20 +38,6 @@ def idle_fleet(fjsp_fleet, key=False, **planner):
 
 def client_of(fleet) -> MissionClient:
     return MissionClient(domain_id=fleet.domain, key_file=fleet.key_file)
-
-
-def of_mission(observer, mission_id):
-    with observer.lock:
-        plans = [p for p in observer.plans if p.mission_id == mission_id]
-        events = [e for e in observer.events if e.mission_id == mission_id]
-    return plans, events
-
-
-def check_done_once(problem, observer, mission_id):
-    """Every job of `problem` done once by the mission, and its executed timeline valid."""
-    plans, events = of_mission(observer, mission_id)
-    check_jobs_done_once(problem, plans, events)
-    check_executed_timeline(problem, plans, events)
 
 
 # --- item E: clients do not lock each other out -------------------------------------------

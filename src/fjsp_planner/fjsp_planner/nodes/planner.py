@@ -84,7 +84,7 @@ from fjsp_planner.execution.mission.settings import PARAMETERS, SETTINGS_PARAMET
 from fjsp_planner.execution.replan import improve, repair
 from fjsp_planner.execution.tracking import Ignored
 from fjsp_planner.model.extension import extend
-from fjsp_planner.model.problem import ProblemError
+from fjsp_planner.model.problem import Problem, ProblemError
 from fjsp_planner.model.scenario import load_scenario, scenario_from_text, scenario_warnings
 from fjsp_planner.nodes.conversions import cancel_msg, job_states, plan_msg
 from fjsp_planner.solving.solve import solve
@@ -315,16 +315,10 @@ class PlannerNode(Node):
         path, records = started[-1]
         head: MissionRecord = records[0]
         try:
-            problem = scenario_from_text(head.scenario_yaml, head.scenario_name,
-                                         head.panels or None,
-                                         head.shift if head.shift >= 0 else None)
-            for record in records:
-                if isinstance(record, JobsAddedRecord):
-                    problem, _ = extend(problem, record.fragment_yaml)
+            problem, settings = self.journaled(records)
         except ProblemError as error:
             log.error(f'cannot resume the mission of {path}: ' + '; '.join(error.problems))
             return ''
-        settings = Settings(**{**self.settings().__dict__, **head.settings})
         self.journal = Journal(path)
         log.warning(f"resuming mission '{head.mission_id}' from {path}")
         self.carry_out(self.controller.resume(head.mission_id, problem, settings,
@@ -344,17 +338,25 @@ class PlannerNode(Node):
         for path, records in waiting:
             head: MissionRecord = records[0]
             try:
-                problem = scenario_from_text(head.scenario_yaml, head.scenario_name,
-                                             head.panels or None,
-                                             head.shift if head.shift >= 0 else None)
+                problem, settings = self.journaled(records)
             except ProblemError as error:
                 close_journal(path, EndRecord('failed', tuple(error.problems)))
                 continue
-            settings = Settings(**{**self.settings().__dict__, **head.settings})
             position = self.controller.requeue(problem, head.mission_id, head.accepted,
                                                settings)
             self.get_logger().warning(f"mission '{head.mission_id}' waits in the queue again "
                                       f'(position {position}), from {path}')
+
+    def journaled(self, records) -> tuple[Problem, Settings]:
+        """The problem (with the jobs added to it) and settings of the mission journaled in
+        `records`; ProblemError if its scenario does not load any more."""
+        head: MissionRecord = records[0]
+        problem = scenario_from_text(head.scenario_yaml, head.scenario_name,
+                                     head.panels or None, head.shift if head.shift >= 0 else None)
+        for record in records:
+            if isinstance(record, JobsAddedRecord):
+                problem, _ = extend(problem, record.fragment_yaml)
+        return problem, Settings(**{**self.settings().__dict__, **head.settings})
 
     def publish_journaled_plan(self, mission_id: str) -> None:
         """Publish again the plan the previous process published last: killed while
