@@ -1,7 +1,7 @@
 """Missions as a service that cannot be confused, over real processes: requests name the
 mission they are for, every client is heard whatever other clients did, missions sent while
 one runs wait their turn in a queue a restarted planner keeps, and `mission submit --wait`
-gives up once the planner is gone."""
+gives up once the planner is gone. A second planner on the domain stands by."""
 
 import copy
 import subprocess
@@ -101,6 +101,14 @@ def test_a_cancel_replayed_after_a_planner_restart_cannot_cancel_a_newer_mission
         result = second.result(timeout=120)
     assert result.complete, result
     assert 'refused' in fleet.log('planner')
+
+
+def until(predicate, timeout: float, what: str) -> None:
+    deadline = time.monotonic() + timeout
+    while not predicate():
+        if time.monotonic() > deadline:
+            pytest.fail(f'timed out after {timeout:g} s waiting for {what}', pytrace=False)
+        time.sleep(0.05)
 
 
 def replay_goal(client: MissionClient, goal) -> RunMission.Result:
@@ -223,3 +231,34 @@ def test_submit_wait_gives_up_with_a_reason_once_the_planner_is_gone(fjsp_fleet)
             submit.communicate()
     assert submit.returncode == 1, out + err
     assert 'the planner has said nothing of mission' in err, err
+
+
+# --- item H: one planner per domain ---------------------------------------------------------
+
+def test_a_second_planner_on_the_domain_stands_by_and_takes_over_when_alone(fjsp_fleet):
+    """Found in the field: two keyed planners on one domain both accepted a goal; one ran
+    the mission, the other stayed BLOCKED for good calling healthy robots failed, and
+    `mission submit --wait` printed both one's and the other's feedback."""
+    fleet = idle_fleet(fjsp_fleet, key=True, rival_timeout=3.0)
+    second = 'planner_second'
+    fleet.start_node(second, 'fjsp_planner', 'planner_node',
+                     {**fleet.extra['planner'], 'scenario': '', 'time_scale': SLOW,
+                      'rival_timeout': 3.0}, ros_args=('-r', f'__node:={second}'))
+    until(lambda: 'standing by' in fleet.log(second), 30, 'the second planner to stand by')
+    assert f'incarnation {fleet.observer.status.auth.incarnation})' in fleet.log(second)
+    done = fleet.run('fjsp_planner', 'mission', 'submit', str(PAPER), '--wait', timeout=120)
+    assert done.returncode == 0, done.stdout + done.stderr
+    shown = {line.split(':')[0] for line in done.stdout.splitlines()
+             if not line.startswith('mission ')}
+    (mission_id,) = {p.mission_id for p in fleet.observer.plans}
+    assert shown == {mission_id}, done.stdout
+    assert 'accepted' not in fleet.log(second)
+    first = fleet.observer.status.auth.incarnation
+    assert {e.auth.incarnation for e in fleet.observer.mission_events} == {first}
+
+    fleet.kill('planner')
+    until(lambda: 'in charge of the fleet: no other planner heard for 3 s'
+          in fleet.log(second), 30, 'the second planner to take charge')
+    with client_of(fleet) as client:
+        result = client.run(PAPER, timeout=120)
+    assert result.complete, result

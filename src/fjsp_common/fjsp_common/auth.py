@@ -123,14 +123,13 @@ class Signer:
         self._counters = Counter()
 
     def sign(self, msg, name: str):
-        """`msg` with its `auth` filled for resolved topic or service `name`; unchanged
-        without a key."""
-        if self.key is None:
-            return msg
+        """`msg` with its `auth` filled for resolved topic or service `name`. Without a key
+        it names its sender all the same (receivers tell senders apart by it), unsigned."""
         self._counters[name] += 1
         msg.auth = Auth(sender=self.sender, incarnation=self.incarnation,
                         counter=self._counters[name], mac=[])
-        msg.auth.mac = list(_digest(self.key, name, msg))
+        if self.key is not None:
+            msg.auth.mac = list(_digest(self.key, name, msg))
         return msg
 
 

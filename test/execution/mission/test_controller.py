@@ -1211,3 +1211,15 @@ def test_a_request_must_name_the_mission_it_is_for(problem, mission_id, why):
         with pytest.raises(ValueError, match=why):
             fleet.controller.cancel(mission_id, 'stop', fleet.wall)
     assert fleet.state() == MissionState.EXECUTING
+
+
+def test_a_planner_that_stands_down_fails_its_missions_and_publishes_no_plan(problem):
+    fleet = executing(problem)
+    fleet.controller.submit(problem, 'm2', fleet.wall)
+    effects = fleet.take(fleet.controller.stand_down('another planner is in charge'))
+    assert not kinds(effects, PublishPlan)
+    assert notes(effects, MissionEventKind.MISSION_FAILED)
+    assert kinds(effects, LeftQueue) == [LeftQueue('m2', MissionState.FAILED,
+                                                   ('another planner is in charge',))]
+    assert fleet.state() == MissionState.FAILED and not fleet.controller.busy
+    assert fleet.status().blocked == ('another planner is in charge',)

@@ -8,12 +8,14 @@ story on `mission_events`, its summary on `mission_status` and per-job states on
 """
 
 import hashlib
+import itertools
 import math
 import os
 import secrets
 import sys
 import threading
 import time
+from collections import deque
 from concurrent.futures import Future, ThreadPoolExecutor
 from datetime import UTC, datetime
 from pathlib import Path
@@ -25,13 +27,16 @@ from rclpy.task import Future as RosFuture
 from rclpy.time import Time
 
 from fjsp_common.auth import NodeAuth
+from fjsp_common.clock import seconds
 from fjsp_common.contract import (
     ADD_JOBS_SERVICE,
     CANCEL_MISSION_SERVICE,
     DIAGNOSTICS,
     EVENT_FROM_MSG,
+    EVENT_HISTORY,
     JOB_STATES,
     JOB_STATES_TOPIC,
+    MAX_FLEET,
     MISSION_EVENT_TO_MSG,
     MISSION_EVENTS,
     MISSION_EVENTS_TOPIC,
@@ -43,6 +48,7 @@ from fjsp_common.contract import (
     ROBOT_STATES,
     ROBOT_STATES_TOPIC,
     RUN_MISSION_ACTION,
+    STATE_FROM_MSG,
     STATE_TO_MSG,
     TASK_EVENTS,
     TASK_EVENTS_TOPIC,
@@ -69,6 +75,7 @@ from fjsp_planner.execution.journal import (
     journals,
     waits_in_queue,
 )
+from fjsp_planner.execution.mission.charge import Change, Charge, Role
 from fjsp_planner.execution.mission.controller import MissionController
 from fjsp_planner.execution.mission.effects import (
     JobDone,
@@ -91,6 +98,10 @@ from fjsp_planner.solving.solve import solve
 
 ANSWERS_KEPT = 256
 """Answers kept per service for requests that are resent."""
+
+WITHDRAW_GRACE = 1.0
+"""Seconds a planner that stood down keeps serving, so the goals it failed get their
+results."""
 
 SOLVER_NICENESS = 10
 
@@ -169,7 +180,9 @@ class PlannerNode(Node):
         self.time_scale, self.start_delay = value['time_scale'], value['start_delay']
         status_period, journal_dir = value['status_period'], value['journal_dir']
         self.journal_dir = Path(journal_dir).expanduser() if journal_dir else None
-        problem = None
+        self.startup = None
+        """The `scenario` parameter's mission, started once this planner takes charge:
+        (problem, text, file, panels, shift, origin)."""
         if scenario:
             try:
                 problem = load_scenario(scenario, panels=panels or None,
@@ -179,7 +192,8 @@ class PlannerNode(Node):
                 problems = getattr(error, 'problems', [str(error)])
                 raise ParameterError(f"parameter 'scenario': cannot use '{scenario}':\n"
                                      + '\n'.join(problems)) from None
-            origin = origin_of(text, panels, shift)
+            self.startup = (problem, text, scenario, panels, shift,
+                            origin_of(text, panels, shift))
 
         self.auth = NodeAuth(self, PLANNER_NODE)
         self.controller = MissionController(self.settings())
@@ -210,41 +224,122 @@ class PlannerNode(Node):
         """Set under `waking` once the node is being destroyed: a solve ending then has no
         guard condition left to trigger."""
 
+        self.charge = Charge(self.incarnation, self.wall(), value['rival_timeout'])
+        self.started_up = False
+        self.servers: list | None = None
+        """The action server and services of mission requests, while this planner serves."""
+        self.withdraw_at: float | None = None
+        """Wall seconds when a planner that stood down withdraws its servers, once its
+        goals have had their answers."""
+        self.unheard: dict[str, deque] = {}
+        """Robot -> the task events heard while this planner was not in charge (as many as
+        its agent keeps for late joiners), with their order of arrival: a journal's mission
+        resumed once it takes charge must know what the robots did meanwhile."""
+        self.arrivals = itertools.count()
+        self.make_publishers()
+        subscription(self, ROBOT_STATES, self.on_robot_state)
+        subscription(self, TASK_EVENTS, self.on_event)
+        subscription(self, PLAN, self.on_plan)
+        subscription(self, MISSION_STATUS, self.on_status)
+        self.create_timer(0.1, self.tick)
+        self.create_timer(status_period, self.publish_periodic)
+        self.create_timer(DIAGNOSTICS_PERIOD, self.publish_diagnostics)
+        self.get_logger().info(f"listening for another planner on this ROS domain for "
+                               f"{value['rival_timeout']:g} s before taking charge")
+
+    def make_publishers(self) -> None:
+        """Fresh writers of every topic the planner publishes: a planner that stood down
+        leaves nothing latched for late joiners."""
+        for name in ('plan_pub', 'status_pub', 'jobs_pub', 'event_pub', 'story_pub',
+                     'diagnostics_pub'):
+            if hasattr(self, name):
+                self.destroy_publisher(getattr(self, name))
         self.plan_pub = publisher(self, PLAN)
         self.status_pub = publisher(self, MISSION_STATUS)
         self.jobs_pub = publisher(self, JOB_STATES)
         self.event_pub = publisher(self, TASK_EVENTS)
         self.story_pub = publisher(self, MISSION_EVENTS)
-        subscription(self, ROBOT_STATES, self.on_robot_state)
-        subscription(self, TASK_EVENTS, self.on_event)
-        subscription(self, PLAN, self.on_plan)
         self.diagnostics_pub = publisher(self, DIAGNOSTICS)
-        self.create_timer(0.1, self.tick)
-        self.create_timer(status_period, self.publish_periodic)
-        self.create_timer(DIAGNOSTICS_PERIOD, self.publish_diagnostics)
-        ActionServer(self, RunMission, RUN_MISSION_ACTION, self.execute_goal,
-                     goal_callback=lambda _: GoalResponse.ACCEPT,
-                     cancel_callback=self.cancel_goal)
-        self.create_service(AddJobs, ADD_JOBS_SERVICE, self.answer_once(self.on_add_jobs))
-        self.create_service(CancelMission, CANCEL_MISSION_SERVICE,
-                            self.answer_once(self.on_cancel))
 
+    def start_up(self) -> None:
+        """What a planner does once it first takes charge: resume what its journal left
+        unfinished, start the `scenario` parameter's mission."""
         resumed = self.resume_unfinished()
-        if problem is None:
+        log = self.get_logger()
+        if self.startup is None:
             if not resumed:
-                self.get_logger().info('no scenario given: waiting for RunMission goals')
-        elif resumed == origin or self.ran_before(origin):
-            self.get_logger().info(f"not starting '{scenario}' again: its mission is in the "
-                                   'journal (resumed or ended)')
+                log.info('no scenario given: waiting for RunMission goals')
+            return
+        problem, text, scenario, panels, shift, origin = self.startup
+        if resumed == origin or self.ran_before(origin):
+            log.info(f"not starting '{scenario}' again: its mission is in the journal "
+                     '(resumed or ended)')
         elif resumed:
-            self.get_logger().warning(f"not starting '{scenario}': the resumed mission "
-                                      'runs on this fleet')
+            log.warning(f"not starting '{scenario}': the resumed mission runs on this fleet")
         else:
-            self.get_logger().info(f"scenario '{problem.name}' from {scenario}: "
-                                   f'{len(problem.jobs)} jobs, robots '
-                                   + ', '.join(r.name for r in problem.robots))
+            log.info(f"scenario '{problem.name}' from {scenario}: {len(problem.jobs)} jobs, "
+                     'robots ' + ', '.join(r.name for r in problem.robots))
             self.submit_mission(problem, text, problem.name, panels, shift, origin,
                                 self.settings())
+
+    # --- who is in charge ------------------------------------------------------------------
+
+    @property
+    def speaking(self) -> bool:
+        """In charge: it publishes what it decides. Listening or standing by, it is silent."""
+        return self.charge.role == Role.IN_CHARGE
+
+    def on_status(self, msg: MissionStatus) -> None:
+        if msg.auth.sender == PLANNER_NODE and msg.auth.incarnation == self.incarnation:
+            return  # its own
+        if not self.auth.accept(msg, MISSION_STATUS_TOPIC, {PLANNER_NODE}):
+            return
+        state = STATE_FROM_MSG.get(msg.state)
+        busy = bool(msg.queue) or (state is not None and state != MissionState.IDLE
+                                   and not state.ended)
+        self.charge.hear(msg.auth.incarnation, busy, msg.mission_id, seconds(msg.stamp),
+                         self.wall())
+
+    def take_role(self, change: Change) -> None:
+        log = self.get_logger()
+        if change.role == Role.IN_CHARGE:
+            log.warning(f'in charge of the fleet: {change.why}')
+            self.serve()
+            if not self.started_up:
+                self.started_up = True
+                self.start_up()
+            self.use_unheard()
+            self.publish_status()
+            return
+        leader = self.charge.leader()
+        log.warning(f'standing by: {change.why}. This planner serves no mission request and '
+                    'publishes nothing until it has heard no other planner for '
+                    f'{self.charge.timeout:g} s')
+        spoke = self.servers is not None
+        self.carry_out(self.controller.stand_down(f'another planner is in charge: {leader}'))
+        if spoke:
+            self.withdraw_at = self.wall() + WITHDRAW_GRACE
+            self.make_publishers()
+
+    def serve(self) -> None:
+        self.withdraw_at = None
+        if self.servers is not None:
+            return
+        self.servers = [
+            ActionServer(self, RunMission, RUN_MISSION_ACTION, self.execute_goal,
+                         goal_callback=lambda _: GoalResponse.ACCEPT,
+                         cancel_callback=self.cancel_goal),
+            self.create_service(AddJobs, ADD_JOBS_SERVICE, self.answer_once(self.on_add_jobs)),
+            self.create_service(CancelMission, CANCEL_MISSION_SERVICE,
+                                self.answer_once(self.on_cancel))]
+
+    def withdraw(self) -> None:
+        """Serve mission requests no more: clients reach only the planner in charge."""
+        action, *services = self.servers
+        action.destroy()
+        for service in services:
+            self.destroy_service(service)
+        self.servers = self.withdraw_at = None
 
     # --- parameters and time -------------------------------------------------------------
 
@@ -584,9 +679,15 @@ class PlannerNode(Node):
 
     def tick(self) -> None:
         self.controller.settings = self.settings()
+        wall = self.wall()
+        change = self.charge.update(self.controller.busy, wall)
+        if change is not None:
+            self.take_role(change)
+        if self.withdraw_at is not None and wall >= self.withdraw_at:
+            self.withdraw()
         if self.journal is not None:
             self.journal.sync()
-        self.carry_out(self.controller.tick(self.wall(), self.plan_pub.get_subscription_count()))
+        self.carry_out(self.controller.tick(wall, self.plan_pub.get_subscription_count()))
 
     def on_robot_state(self, msg: RobotState) -> None:
         if not self.auth.accept(msg, ROBOT_STATES_TOPIC, {msg.robot}):
@@ -610,6 +711,25 @@ class PlannerNode(Node):
         senders = {PLANNER_NODE} if msg.kind == TaskEvent.KIND_JOB_DONE else {msg.robot}
         if not self.auth.accept(msg, TASK_EVENTS_TOPIC, senders):
             return
+        if self.speaking:
+            self.use_event(msg)
+            return
+        history = self.unheard.get(msg.robot)
+        if history is None and len(self.unheard) < MAX_FLEET:
+            history = self.unheard[msg.robot] = deque(maxlen=EVENT_HISTORY)
+        if history is not None:
+            history.append((next(self.arrivals), msg))
+
+    def use_unheard(self) -> None:
+        """Give the controller the task events heard while this planner was not in charge,
+        in their order."""
+        unheard = sorted((item for history in self.unheard.values() for item in history),
+                         key=lambda item: item[0])
+        self.unheard = {}
+        for _, msg in unheard:
+            self.use_event(msg)
+
+    def use_event(self, msg: TaskEvent) -> None:
         kind = EVENT_FROM_MSG.get(msg.kind)
         if kind is None:
             self.ignore(Ignored.UNKNOWN, f"event '{shorten(msg.event_id)}': kind {msg.kind} "
@@ -624,8 +744,9 @@ class PlannerNode(Node):
         self.carry_out(effects)
 
     def on_plan(self, msg: Plan) -> None:
-        if (msg.mission_id, msg.revision, msg.stamp) == self.last_published:
-            return
+        if (msg.mission_id, msg.revision, msg.stamp) == self.last_published \
+                or not self.speaking:
+            return  # its own, or the plan of the planner in charge
         if not self.auth.accept(msg, PLAN_TOPIC, {PLANNER_NODE}):
             return
         current = self.controller.mission
@@ -809,6 +930,9 @@ class PlannerNode(Node):
     def tell(self, note: Note) -> None:
         mission = self.controller.mission
         wall = self.wall()
+        self.get_logger().info(shorten(describe(note), 2000))
+        if not self.speaking:
+            return
         self.event_count += 1
         self.story_pub.publish(self.auth.sign(MissionEvent(
             stamp=self.get_clock().now().to_msg(),
@@ -817,9 +941,10 @@ class PlannerNode(Node):
             plan_revision=mission.tracker.revision if note.revision is None else note.revision,
             time=max(self.controller.now_units(wall), 0.0), robot=note.robot, job=note.job,
             reasons=list(note.reasons)), MISSION_EVENTS_TOPIC))
-        self.get_logger().info(shorten(describe(note), 2000))
 
     def publish_diagnostics(self) -> None:
+        if not self.speaking:
+            return
         view = self.controller.status(self.wall())
         if view is None:
             self.diagnostics_pub.publish(diagnostic_array(
@@ -842,7 +967,7 @@ class PlannerNode(Node):
 
     def publish_jobs(self) -> None:
         mission = self.controller.mission
-        if mission is None or mission.tracker.plan is None:
+        if not self.speaking or mission is None or mission.tracker.plan is None:
             return
         self.jobs_pub.publish(self.auth.sign(JobStates(
             stamp=self.get_clock().now().to_msg(), mission_id=mission.id,
@@ -873,6 +998,8 @@ class PlannerNode(Node):
             goal.handle.publish_feedback(feedback)
 
     def publish_status(self) -> None:
+        if not self.speaking:
+            return
         view = self.controller.status(self.wall())
         if view is None:
             # Heard by `mission status`, monitors and recorders before any mission: they

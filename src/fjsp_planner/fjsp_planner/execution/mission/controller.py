@@ -270,6 +270,21 @@ class MissionController:
                                           (reason,), mission.start, cancelled=True))
         return effects
 
+    def stand_down(self, reason: str) -> list[Effect]:
+        """Another planner is in charge: the running mission fails and the queued ones leave
+        the queue failed, with `reason`. No plan goes out: the robots follow the other."""
+        effects: list[Effect] = []
+        mission = self.mission
+        if mission is not None and not mission.state.ended:
+            mission.solving = mission.improving = None
+            effects += self._fail(mission, (reason,))
+        for waiting in self.queue:
+            waiting.enter(MissionState.FAILED)
+            waiting.failure = (reason,)
+            effects.append(LeftQueue(waiting.id, MissionState.FAILED, (reason,)))
+        self.queue = []
+        return effects
+
     def add_jobs(self, problem: Problem, jobs: tuple[str, ...], wall: float) -> list[Effect]:
         """The running mission grows to `problem`, which adds `jobs` (checked by
         `core.extension.extend`); they are planned in like any re-plan."""

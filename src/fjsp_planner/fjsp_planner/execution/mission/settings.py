@@ -46,6 +46,9 @@ PARAMETERS = table(
                   low=0.01, high=60.0),
     ParameterSpec('journal_dir', '', 'directory of the mission journals that let a restarted '
                   'planner resume its mission; empty: no journal'),
+    ParameterSpec('rival_timeout', 3.0, 'seconds a planner listens for another planner on '
+                  'its ROS domain before it takes charge; a planner standing by takes charge '
+                  'once the one in charge has been silent this long', low=0.5, high=600.0),
     ParameterSpec('queue_limit', 16, 'missions that may wait their turn behind the running '
                   'one; 0: a goal sent while a mission runs is refused', low=0, high=1000,
                   read_only=False),

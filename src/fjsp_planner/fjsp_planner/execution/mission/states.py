@@ -22,6 +22,7 @@ TRANSITIONS: Mapping[MissionState, frozenset[MissionState]] = {
     MissionState.QUEUED: frozenset({
         MissionState.WAITING_FOR_ROBOTS,    # its turn: the missions before it ended
         MissionState.CANCELLED,             # taken out of the queue
+        MissionState.FAILED,                # the planner stood down for another one
     }),
     MissionState.WAITING_FOR_ROBOTS: frozenset({
         MissionState.PLANNING,      # every robot reported, or the robot wait is over
