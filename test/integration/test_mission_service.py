@@ -149,7 +149,8 @@ def test_missions_wait_their_turn_and_a_queued_one_can_be_cancelled(fjsp_fleet):
     fleet = idle_fleet(fjsp_fleet)
     observer = fleet.observer
     with client_of(fleet) as client:
-        running = client.submit(PAPER)
+        # Long enough (32 units of 0.5 s) for the queue to be looked at and changed.
+        running = client.submit(PAPER, time_scale=0.5)
         queued = [client.submit(PAPER) for _ in range(3)]
         assert running.queue_position == 0
         assert [m.queue_position for m in queued] == [1, 2, 3]
@@ -164,7 +165,7 @@ def test_missions_wait_their_turn_and_a_queued_one_can_be_cancelled(fjsp_fleet):
         assert client.cancel(third.mission_id) == \
             f"mission '{third.mission_id}' taken out of the queue"
         assert third.result(timeout=10).state == 'cancelled'
-        ends = [m.result(timeout=120) for m in (running, second, fourth)]
+        ends = [m.result(timeout=180) for m in (running, second, fourth)]
     assert all(r.complete for r in ends), ends
     problem = load_scenario(PAPER)
     for mission in (running, second, fourth):
