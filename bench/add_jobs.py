@@ -58,7 +58,8 @@ def trial(fleet: FleetHarness, client: MissionClient, panels: int, args) -> floa
                       and o.status.mission_id == mission.mission_id
                       and o.status.jobs_done >= 2, args.timeout, 'the mission under way')
     began = time.monotonic()
-    added = set(client.add_jobs(fragment_yaml=one_more_panel(panels)))
+    added = set(client.add_jobs(fragment_yaml=one_more_panel(panels),
+                                mission_id=mission.mission_id))
 
     def followed(o) -> bool:
         plans = [p for p in o.plans if p.mission_id == mission.mission_id

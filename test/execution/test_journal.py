@@ -13,10 +13,12 @@ from fjsp_planner.execution.journal import (
     JournalError,
     MissionRecord,
     PlanRecord,
+    StartRecord,
     journal_path,
     journals,
     read_journal,
     unfinished,
+    waits_in_queue,
 )
 from fjsp_planner.model.schedule import JobAssignment, Schedule
 
@@ -24,9 +26,9 @@ ASSIGNMENT = JobAssignment('Ja', 0, Fraction(7, 3), Fraction(22, 3), {'MARC1': 0
 SCHEDULE = Schedule({'Ja': ASSIGNMENT}, {'MARC1': ('Ja',), 'LSMS': ('Ja',), 'MARC2': ()})
 
 
-def mission(mission_id='m1', accepted=10.0):
+def mission(mission_id='m1', accepted=10.0, queued=False):
     return MissionRecord(mission_id, 'name: x\n', 'x', 2, -1.0, 'parameter:abc',
-                         {'time_scale': 0.1}, accepted)
+                         {'time_scale': 0.1}, accepted, queued)
 
 
 def test_records_round_trip_exactly(tmp_path):
@@ -71,3 +73,17 @@ def test_unfinished_missions_oldest_first(tmp_path):
     (tmp_path / 'junk.journal').write_text('not json\n\n')
     assert [records[0].mission_id for _, records in journals(tmp_path)] == ['c', 'b', 'a']
     assert [records[0].mission_id for _, records in unfinished(tmp_path)] == ['b', 'a']
+
+
+def test_a_queued_mission_waits_until_its_start_is_journaled(tmp_path):
+    path = journal_path(tmp_path, 'm2')
+    journal = Journal(path)
+    journal.write(mission('m2', queued=True))
+    assert read_journal(path) == [mission('m2', queued=True)]
+    assert waits_in_queue(read_journal(path))
+    journal.write(StartRecord(42.5))
+    journal.close()
+    assert read_journal(path) == [mission('m2', queued=True), StartRecord(42.5)]
+    assert not waits_in_queue(read_journal(path))
+    assert not waits_in_queue([mission('m3', queued=True), EndRecord('cancelled', ('x',))])
+    assert not waits_in_queue([mission('m4')])

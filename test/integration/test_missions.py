@@ -2,7 +2,6 @@
 rejected goals, jobs added mid-mission, and a planner killed and restarted mid-mission."""
 
 import time
-from collections import Counter
 
 import pytest
 import yaml
@@ -11,8 +10,9 @@ from fjsp_common.fleet import agent_node_name
 from fjsp_msgs.msg import MissionStatus, RobotState, TaskEvent
 from fjsp_planner.missions import MissionClient, MissionError
 from fjsp_planner.model.scenario import load_scenario
-from fjsp_planner.testing import Observer, executed_timeline, validate_executed
+from fjsp_planner.testing import Observer
 
+from mission_checks import check_done_once, of_mission
 from repo_paths import PAPER
 
 ROBOTS = ('Assembler', 'LSMS', 'MARC1', 'MARC2')
@@ -41,27 +41,6 @@ def client(idle_fleet):
 @pytest.fixture
 def observer(idle_fleet):
     return idle_fleet.observer
-
-
-def of_mission(observer, mission_id):
-    with observer.lock:
-        plans = [p for p in observer.plans if p.mission_id == mission_id]
-        events = [e for e in observer.events if e.mission_id == mission_id]
-    return plans, events
-
-
-def check_done_once(problem, observer, mission_id):
-    """Every job of `problem` started and completed exactly once by each of its robots, and
-    the executed timeline is valid."""
-    observer.wait_for(lambda o: sum(e.kind == TaskEvent.KIND_JOB_DONE and e.mission_id ==
-                                    mission_id for e in o.events) >= len(problem.jobs), 10,
-                      'every job-done event')
-    plans, events = of_mission(observer, mission_id)
-    starts = Counter((e.job, e.robot) for e in events if e.kind == TaskEvent.KIND_STARTED)
-    assert set(starts.values()) == {1}, starts
-    executed = executed_timeline(problem, plans, events)
-    assert sorted(executed.jobs) == sorted(j.name for j in problem.jobs)
-    assert validate_executed(problem, executed) == []
 
 
 def fleet_is_idle(observer):
@@ -96,10 +75,10 @@ def test_successive_missions_on_one_fleet(client, observer):
     assert plans[0].revision == 1
 
 
-def test_goal_during_a_mission_and_broken_goal_are_rejected(client, observer):
+def test_goal_that_will_not_wait_and_broken_goal_are_rejected(client, observer):
     running = client.submit(PAPER)
     with pytest.raises(MissionError, match='one mission per fleet') as busy:
-        client.submit(PAPER)
+        client.submit(PAPER, queue=False)
     assert running.mission_id in str(busy.value)
     broken = {'operation_types': {0: 'weld'}, 'robot_types': {'W': {'weld': 1}},
               'robots': [{'name': 'R1', 'type': 'Welder'}],

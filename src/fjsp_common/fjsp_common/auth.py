@@ -29,6 +29,12 @@ from fjsp_common.running import ParameterError, declare, shorten
 from fjsp_msgs.msg import Auth
 
 KEY_BYTES = 32
+CLIENT_ID_BYTES = 4
+"""Random bytes in the name each client signs under (`client_signer`)."""
+SENDERS_KEPT = 4096
+"""Senders a receiver remembers the latest message of, per topic or service; beyond them, the
+least recently heard is forgotten. Clients sign under names of their own, so a long-running
+planner hears a new sender at every command a user types."""
 KEY_FILE_VARIABLE = 'FJSP_FLEET_KEY_FILE'
 """Where command-line tools and scripts find the fleet key when not told otherwise."""
 FLEET_KEY_FILE = ParameterSpec('fleet_key_file', '',
@@ -95,11 +101,16 @@ def _canonical(value):
     return [_canonical(item) for item in value]
 
 
-def client_signer(key_file, sender: str) -> 'Signer':
+def client_signer(key_file, role: str) -> 'Signer':
     """The signer of a tool or script: the key in `key_file`, else in the file named by
-    $FJSP_FLEET_KEY_FILE, else none (unsigned requests, for an unauthenticated fleet)."""
+    $FJSP_FLEET_KEY_FILE, else none (unsigned requests, for an unauthenticated fleet).
+
+    Each client signs under a name of its own, `<role>/<random id>`: replay protection orders
+    the messages of each sender, so clients sharing a name would order each other's, and a
+    long-lived client's requests would be refused as replays once a newer client had spoken."""
     path = key_file or os.environ.get(KEY_FILE_VARIABLE) or None
-    return Signer(read_key(path) if path else None, sender)
+    return Signer(read_key(path) if path else None,
+                  f'{role}/{secrets.token_hex(CLIENT_ID_BYTES)}')
 
 
 class Signer:
@@ -112,14 +123,13 @@ class Signer:
         self._counters = Counter()
 
     def sign(self, msg, name: str):
-        """`msg` with its `auth` filled for resolved topic or service `name`; unchanged
-        without a key."""
-        if self.key is None:
-            return msg
+        """`msg` with its `auth` filled for resolved topic or service `name`. Without a key
+        it names its sender all the same (receivers tell senders apart by it), unsigned."""
         self._counters[name] += 1
         msg.auth = Auth(sender=self.sender, incarnation=self.incarnation,
                         counter=self._counters[name], mac=[])
-        msg.auth.mac = list(_digest(self.key, name, msg))
+        if self.key is not None:
+            msg.auth.mac = list(_digest(self.key, name, msg))
         return msg
 
 
@@ -151,10 +161,13 @@ class Verifier:
         if senders is not None and auth.sender not in senders:
             return f"'{auth.sender[:80]}' may not send this"
         stamp = (auth.incarnation, auth.counter)
-        latest = self._latest.get((name, auth.sender))
+        latest = self._latest.pop((name, auth.sender), None)
         if latest is not None and stamp <= latest:
+            self._latest[name, auth.sender] = latest
             return f"replayed message of '{auth.sender[:80]}' (counter {auth.counter})"
         self._latest[name, auth.sender] = stamp
+        if len(self._latest) > SENDERS_KEPT:
+            del self._latest[next(iter(self._latest))]
         return ''
 
 
@@ -203,13 +216,18 @@ class NodeAuth:
     def accept(self, msg, name: str, senders=None, service: bool = False) -> bool:
         """Whether `msg` received on `name` verifies; if not, it is counted and warned about
         once per sender and reason."""
+        return not self.refusal(msg, name, senders, service)
+
+    def refusal(self, msg, name: str, senders=None, service: bool = False) -> str:
+        """Why `msg` received on `name` does not verify ('' if it does), for an answer to
+        its sender: counted and warned about as by `accept`."""
         why = self.verifier.check(msg, self.resolve(name, service), senders)
         if not why:
-            return True
+            return ''
         kind = why.split(':')[0].split("'")[0]
         key = (name, shorten(msg.auth.sender, 80), kind)
         if key not in self._warned:
             self._warned.add(key)
             self.node.get_logger().warning(f'dropping an unauthenticated message on {name} '
                                            f'({why}); further ones like it are only counted')
-        return False
+        return why

@@ -48,6 +48,8 @@ class MissionState(StrEnum):
 
     IDLE = 'idle'
     """No mission: the planner waits for one."""
+    QUEUED = 'queued'
+    """Accepted while another mission runs: waits in the planner's queue for its turn."""
     WAITING_FOR_ROBOTS = 'waiting for robots'
     """Accepted: waits until every robot reported (at most `robot_wait_timeout`)."""
     PLANNING = 'planning'

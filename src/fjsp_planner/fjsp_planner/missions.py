@@ -1,8 +1,9 @@
 """Submit, follow, extend and cancel missions on a running fleet, from a shell or a script.
 
     ros2 run fjsp_planner mission submit SCENARIO [--panels N] [--time-scale S] [--wait]
-    ros2 run fjsp_planner mission cancel [--reason TEXT]
-    ros2 run fjsp_planner mission add FRAGMENT.yaml
+                                                  [--no-queue]
+    ros2 run fjsp_planner mission cancel [--mission ID] [--reason TEXT]
+    ros2 run fjsp_planner mission add FRAGMENT.yaml [--mission ID]
     ros2 run fjsp_planner mission status
 
 From Python (a test script, a mission monitor):
@@ -17,7 +18,10 @@ From Python (a test script, a mission monitor):
 The client owns a private ROS context, node and executor thread, so it works whether or not
 the caller uses rclpy, and never spins (or waits on) the caller's nodes. It discovers the
 planner once and stays ready: keep one client for a whole script. A scenario file is sent as
-its YAML text, so the planner may run on another machine.
+its YAML text, so the planner may run on another machine. A mission submitted while another
+runs waits its turn in the planner's queue. Requests that change a mission name it: `cancel`
+and `add_jobs` without a mission id are for the running mission, as the planner's status
+names it.
 """
 
 import argparse
@@ -35,6 +39,9 @@ RESEND = 1.0
 """Seconds without an answer after which a request is sent again."""
 SEND_TIMEOUT = 10.0
 """Seconds a request may wait for the client's executor thread to send it."""
+SILENCE = 10.0
+"""Seconds without feedback on a submitted mission after which the planner is taken for gone:
+it gives feedback with every status it publishes (every `status_period`, 0.5 s by default)."""
 RESULT_STATES = ('complete', 'cancelled', 'failed', 'blocked too long', 'rejected')
 """RunMission.Result.STATE_* in order."""
 
@@ -64,19 +71,63 @@ class MissionResult:
         return self.state == 'complete'
 
 
-class MissionHandle:
-    """A submitted mission: its id, its feedback as it comes, its result when it ends."""
+class _Feedback:
+    """What the planner said of one goal so far: called with each feedback message."""
 
-    def __init__(self, client: 'MissionClient', goal_handle, mission_id: str):
+    def __init__(self, user=None):
+        self.user = user
+        self.first = threading.Event()
+        self.mission_id = ''
+        self.queue_position = 0
+        self.heard = time.monotonic()
+
+    def __call__(self, msg):
+        feedback = msg.feedback
+        self.heard = time.monotonic()
+        self.mission_id = self.mission_id or feedback.mission_id
+        self.queue_position = feedback.queue_position
+        self.first.set()
+        if self.user is not None:
+            self.user(feedback)
+
+
+class MissionHandle:
+    """A submitted mission: its id, its place in the queue, its feedback as it comes, its
+    result when it ends."""
+
+    def __init__(self, client: 'MissionClient', goal_handle, feedback: _Feedback):
         self._client = client
         self._goal = goal_handle
-        self.mission_id = mission_id
+        self._feedback = feedback
+        self.mission_id = ''
         self._result = client._sent(goal_handle.get_result_async)
+        self._ended = threading.Event()
+        self._result.add_done_callback(lambda _: self._ended.set())
 
-    def result(self, timeout: float | None = None) -> MissionResult:
-        """Wait for the mission to end; MissionError after `timeout` seconds."""
-        if not self._client._wait(self._result, timeout):
-            raise MissionError(f"mission '{self.mission_id}' did not end within {timeout:g} s")
+    @property
+    def queue_position(self) -> int:
+        """Where the mission waits in the planner's queue (1: next), as last heard; 0 once
+        it runs."""
+        return self._feedback.queue_position
+
+    def result(self, timeout: float | None = None, silence: float | None = SILENCE
+               ) -> MissionResult:
+        """Wait for the mission to end; MissionError after `timeout` seconds, or once the
+        planner has said nothing of the mission for `silence` seconds (it stopped, or the
+        link to it is down: its result would never come)."""
+        deadline = None if timeout is None else time.monotonic() + timeout
+        while not self._ended.wait(0.2):
+            now = time.monotonic()
+            if deadline is not None and now >= deadline:
+                raise MissionError(f"mission '{self.mission_id}' did not end within "
+                                   f'{timeout:g} s')
+            if silence is not None and now - self._feedback.heard > silence:
+                gone = '' if self._client._action.server_is_ready() else \
+                    f"; no planner serves '{self._client._action_name}' any more"
+                raise MissionError(
+                    f"the planner has said nothing of mission '{self.mission_id}' for "
+                    f'{silence:g} s{gone}: it stopped, or the link to it is down, and the '
+                    "mission's result will not come ('mission status' says what runs now)")
         return _result(self._result.result().result)
 
     def cancel(self, timeout: float = 10.0) -> None:
@@ -187,9 +238,10 @@ class MissionClient:
     def submit(self, scenario=None, *, scenario_yaml: str = '', name: str = '',
                panels: int = 0, shift: float = -1.0, time_scale: float = 0.0,
                time_limit: float = 0.0, replan_time_limit: float = 0.0,
-               blocked_timeout: float = 0.0, feedback=None,
+               blocked_timeout: float = 0.0, queue: bool = True, feedback=None,
                timeout: float = 10.0) -> MissionHandle:
-        """Start a mission: `scenario` is a file (sent as its text), or give the text as
+        """Start a mission, or queue it behind the running one (with `queue` False, it is
+        rejected instead): `scenario` is a file (sent as its text), or give the text as
         `scenario_yaml`. `feedback(RunMission.Feedback)` is called as the mission goes.
         MissionError if the planner does not answer within `timeout` or rejects it (with
         every problem of the scenario)."""
@@ -207,21 +259,12 @@ class MissionClient:
         goal = RunMission.Goal(scenario_yaml=scenario_yaml, scenario_name=name, panels=panels,
                                shift=shift, time_limit=time_limit,
                                replan_time_limit=replan_time_limit, time_scale=time_scale,
-                               blocked_timeout=blocked_timeout)
+                               blocked_timeout=blocked_timeout, no_queue=not queue)
         if not self._action.wait_for_server(timeout_sec=timeout):
             raise MissionError(f"no planner serves '{self._action_name}' (waited "
                                f'{timeout:g} s): is the planner running, with the same '
                                'ROS_DOMAIN_ID?')
-        first = threading.Event()
-        named = []
-
-        def on_feedback(msg):
-            if not first.is_set():
-                named.append(msg.feedback.mission_id)
-                first.set()
-            if feedback is not None:
-                feedback(msg.feedback)
-
+        heard = _Feedback(feedback)
         # A fresh client's first answer can be lost: the goal is resent, with the same
         # request id, until one is answered; the planner hands the mission to the latest.
         goal.request_id = f'{self._node.get_name()}/{uuid.uuid4().hex}'
@@ -229,7 +272,7 @@ class MissionClient:
         while True:
             self._signer.sign(goal, self._node.resolve_topic_name(self._action_name))
             accepted = self._sent(lambda: self._action.send_goal_async(
-                goal, feedback_callback=on_feedback))
+                goal, feedback_callback=heard))
             if self._wait(accepted, min(RESEND, max(deadline - time.monotonic(), 0.0))):
                 break
             if time.monotonic() >= deadline:
@@ -237,22 +280,30 @@ class MissionClient:
         goal_handle = accepted.result()
         if not goal_handle.accepted:
             raise MissionError('the planner refused the goal')
-        handle = MissionHandle(self, goal_handle, '')
-        # A started mission names itself in its first feedback; a rejected one ends at once.
+        heard.heard = time.monotonic()
+        handle = MissionHandle(self, goal_handle, heard)
+        # A mission started or queued names itself in its first feedback; a rejected one
+        # ends at once.
         deadline = time.monotonic() + timeout
-        while not first.is_set() and not handle._result.done() \
+        while not heard.first.is_set() and not handle._ended.is_set() \
                 and time.monotonic() < deadline:
-            first.wait(0.02)
-        if handle._result.done():
+            heard.first.wait(0.02)
+        if handle._ended.is_set():
             result = _result(handle._result.result().result)
             if result.state == 'rejected':
                 raise MissionError('mission rejected', result.reasons)
             handle.mission_id = result.mission_id
-        elif named:
-            handle.mission_id = named[0]
+        elif heard.first.is_set():
+            handle.mission_id = heard.mission_id
         else:
             raise MissionError(f'the planner accepted the goal but said nothing of it within '
                                f'{timeout:g} s')
+        # The planner published the status naming a mission it started before its feedback,
+        # on another topic: once it is here, `cancel()` and `add_jobs()` find the mission.
+        while handle.queue_position == 0 and not handle._ended.is_set() \
+                and getattr(self._status, 'mission_id', '') != handle.mission_id \
+                and time.monotonic() < deadline:
+            time.sleep(0.02)
         return handle
 
     def run(self, scenario=None, *, timeout: float | None = None, **goal) -> MissionResult:
@@ -260,9 +311,11 @@ class MissionClient:
         return self.submit(scenario, **goal).result(timeout)
 
     def cancel(self, mission_id: str = '', reason: str = '', timeout: float = 10.0) -> str:
-        """Cancel the running mission (or `mission_id`); the planner's answer."""
+        """Cancel mission `mission_id`, running or queued (default: the running one, as the
+        planner's status names it); the planner's answer."""
         from fjsp_msgs.srv import CancelMission
 
+        mission_id = mission_id or self.running_mission(timeout)
         response = self._call(self._cancel, CancelMission.Request(mission_id=mission_id,
                                                                   reason=reason), timeout)
         if not response.success:
@@ -271,8 +324,9 @@ class MissionClient:
 
     def add_jobs(self, fragment=None, *, fragment_yaml: str = '', mission_id: str = '',
                  timeout: float = 10.0) -> list[str]:
-        """Add the jobs of a scenario fragment (a file, or its text) to the running mission;
-        the names added. MissionError lists every problem of a refused fragment."""
+        """Add the jobs of a scenario fragment (a file, or its text) to mission `mission_id`
+        (default: the running one, as the planner's status names it); the names added.
+        MissionError lists every problem of a refused fragment."""
         from fjsp_msgs.srv import AddJobs
 
         if (fragment is None) == (not fragment_yaml):
@@ -282,11 +336,27 @@ class MissionClient:
                 fragment_yaml = Path(fragment).read_text()
             except (OSError, UnicodeDecodeError) as error:
                 raise MissionError(f'{fragment}: cannot read the fragment: {error}') from None
+        mission_id = mission_id or self.running_mission(timeout)
         response = self._call(self._add, AddJobs.Request(mission_id=mission_id,
                                                          fragment_yaml=fragment_yaml), timeout)
         if not response.success:
             raise MissionError(response.message, response.problems)
         return list(response.jobs)
+
+    def running_mission(self, timeout: float = 10.0) -> str:
+        """The id of the mission running now, as the planner's status names it; MissionError
+        if none runs."""
+        from fjsp_common.contract import STATE_FROM_MSG
+        from fjsp_common.vocabulary import MissionState
+
+        status = self.status(timeout)
+        state = STATE_FROM_MSG.get(status.state, f'state {status.state}')
+        if state == MissionState.IDLE or not status.mission_id:
+            raise MissionError('no mission runs: the planner waits for one')
+        if state in (MissionState.COMPLETE, MissionState.CANCELLED, MissionState.FAILED):
+            raise MissionError(f"no mission runs: the last one, '{status.mission_id}', has "
+                               f'ended ({state})')
+        return status.mission_id
 
     def status(self, timeout: float = 10.0):
         """The latest MissionStatus (latched: it comes as soon as the planner is found)."""
@@ -325,8 +395,12 @@ def _result(msg) -> MissionResult:
 
 def describe_feedback(feedback) -> str:
     from fjsp_common.contract import STATE_FROM_MSG
+    from fjsp_common.vocabulary import MissionState
 
     state = STATE_FROM_MSG.get(feedback.state, f'state {feedback.state}')
+    if state == MissionState.QUEUED:
+        return (f'{feedback.mission_id}: queued, position {feedback.queue_position}, '
+                f'{feedback.jobs_total} jobs')
     line = (f'{feedback.mission_id}: {state}, revision {feedback.plan_revision}, '
             f'{feedback.jobs_done}/{feedback.jobs_total} jobs done, {feedback.jobs_running} '
             'running, makespan planned {} projected {}, t={}'.format(
@@ -356,12 +430,19 @@ def _parser():
                         help='fail the mission after being blocked this long (s); 0: never')
     submit.add_argument('--wait', action='store_true',
                         help='follow the mission to its end, printing its progress; exit 0 '
-                             'only if it completes')
-    cancel = verbs.add_parser('cancel', help='cancel the running mission')
+                             'only if it completes, 1 as soon as the planner says nothing '
+                             'of it for --timeout seconds')
+    submit.add_argument('--no-queue', action='store_true',
+                        help='refused if a mission runs, rather than waiting its turn')
+    cancel = verbs.add_parser('cancel', help='cancel the running mission, or a queued one')
     cancel.add_argument('--reason', default='', help='shown in the mission story')
     add = verbs.add_parser('add', help='add the jobs of a scenario fragment')
     add.add_argument('fragment', type=Path)
-    verbs.add_parser('status', help='print the mission state and jobs done')
+    for verb in (cancel, add):
+        verb.add_argument('--mission', default='', metavar='ID',
+                          help="the mission's id (default: the running mission, as the "
+                               "planner's status names it)")
+    verbs.add_parser('status', help='print the mission state, jobs done and the queue')
     for verb in (submit, cancel, add, verbs.choices['status']):
         verb.add_argument('--timeout', type=float, default=10.0,
                           help='seconds to wait for the planner (default 10)')
@@ -412,19 +493,21 @@ def _run(client: MissionClient, args) -> int:
                 print(line, flush=True)
 
         mission = client.submit(args.scenario, panels=args.panels, time_scale=args.time_scale,
-                                blocked_timeout=args.blocked_timeout, feedback=show,
-                                timeout=args.timeout)
-        print(f'mission {mission.mission_id} started', flush=True)
+                                blocked_timeout=args.blocked_timeout,
+                                queue=not args.no_queue, feedback=show, timeout=args.timeout)
+        position = mission.queue_position
+        print(f'mission {mission.mission_id} '
+              + (f'queued at position {position}' if position else 'started'), flush=True)
         if not args.wait:
             return 0
-        result = mission.result()
+        result = mission.result(silence=args.timeout)
         print(describe_result(result))
         return 0 if result.complete else 1
     if args.verb == 'cancel':
-        print(client.cancel(reason=args.reason, timeout=args.timeout))
+        print(client.cancel(args.mission, reason=args.reason, timeout=args.timeout))
         return 0
     if args.verb == 'add':
-        jobs = client.add_jobs(args.fragment, timeout=args.timeout)
+        jobs = client.add_jobs(args.fragment, mission_id=args.mission, timeout=args.timeout)
         print(f'{len(jobs)} job(s) added: {", ".join(jobs)}')
         return 0
     from fjsp_common.contract import STATE_FROM_MSG
@@ -434,13 +517,15 @@ def _run(client: MissionClient, args) -> int:
     state = STATE_FROM_MSG.get(status.state, f'state {status.state}')
     if state == MissionState.IDLE:
         print('idle: no mission yet, the planner waits for one')
-        return 0
-    print(f'{state} {status.jobs_done}/{status.jobs_total}  mission {status.mission_id} '
-          f'revision {status.plan_revision}')
+    else:
+        print(f'{state} {status.jobs_done}/{status.jobs_total}  mission {status.mission_id} '
+              f'revision {status.plan_revision}')
     for reason in status.blocked_reasons:
         print(f'  blocked: {reason}')
     for warning in status.warnings:
         print(f'  warning: {warning}')
+    for position, mission_id in enumerate(status.queue, 1):
+        print(f'  queued {position}: {mission_id}')
     return 0
 
 

@@ -62,8 +62,9 @@ from fjsp_planner.model.validate import validate
 
 TEST_TIME_SCALE = 0.03
 """Wall seconds per schedule unit: the paper's 32-unit mission takes about a second."""
-TEST_PLANNER = {'time_limit': 5.0, 'start_delay': 0.3}
-"""Planner parameters for tests: a first plan within 5 s, a mission start soon after it."""
+TEST_PLANNER = {'time_limit': 5.0, 'start_delay': 0.3, 'rival_timeout': 1.0}
+"""Planner parameters for tests: a first plan within 5 s, a mission start soon after it, and
+1 s of listening for another planner (there is none: the domain is the test's own)."""
 DISCOVERY_RANGE = 'LOCALHOST'
 ACROSS_HOSTS = {'ROS_AUTOMATIC_DISCOVERY_RANGE': 'SUBNET', 'FASTDDS_BUILTIN_TRANSPORTS': 'UDPv4'}
 """DDS settings of a fleet whose nodes run on separate hosts: discovery by multicast on the

@@ -15,6 +15,7 @@ from fjsp_planner.execution.mission.continuation import DUE_GRACE
 from fjsp_planner.execution.mission.controller import IMPROVE_REACH, MissionController
 from fjsp_planner.execution.mission.effects import (
     JobDone,
+    LeftQueue,
     Note,
     PublishPlan,
     ResendPlan,
@@ -630,13 +631,13 @@ def test_cancel_publishes_a_cancelling_revision_and_frees_the_fleet(problem):
     fleet = executing(problem)
     with pytest.raises(ValueError, match='one mission per fleet'):
         fleet.controller.start(problem, 'm2', fleet.wall)
-    effects = fleet.take(fleet.controller.cancel('operator cancelled', fleet.wall))
+    effects = fleet.take(fleet.controller.cancel('m1', 'operator cancelled', fleet.wall))
     (cancelling,) = kinds(effects, PublishPlan)
     assert cancelling.cancelled and cancelling.revision == 2
     assert fleet.state() == MissionState.CANCELLED
     assert fleet.status().blocked == ('operator cancelled',)
-    with pytest.raises(ValueError, match='no mission is running'):
-        fleet.controller.cancel('again', fleet.wall)
+    with pytest.raises(ValueError, match="mission 'm1' has ended: cancelled"):
+        fleet.controller.cancel('m1', 'again', fleet.wall)
     fleet.controller.start(problem, 'm2', fleet.wall)
     assert fleet.controller.mission.id == 'm2'
 
@@ -931,7 +932,7 @@ def test_a_search_for_a_better_plan_is_dropped_when_the_fleet_changes(problem):
 def test_a_mission_waiting_for_robots_can_be_cancelled(problem):
     fleet = Fleet(problem)
     fleet.start()
-    effects = fleet.take(fleet.controller.cancel('operator stop', fleet.wall))
+    effects = fleet.take(fleet.controller.cancel('m1', 'operator stop', fleet.wall))
     assert fleet.state() == MissionState.CANCELLED
     assert notes(effects, MissionEventKind.MISSION_CANCELLED)
     assert not kinds(effects, PublishPlan)  # no plan was ever published: nothing to revoke
@@ -941,7 +942,7 @@ def test_a_mission_cancelled_while_its_first_plan_is_solved_publishes_no_plan(pr
     fleet = Fleet(problem)
     fleet.start()
     request = fleet.tick_until_solve()
-    fleet.take(fleet.controller.cancel('operator stop', fleet.wall))
+    fleet.take(fleet.controller.cancel('m1', 'operator stop', fleet.wall))
     assert not fleet.run_solves([request])
     assert fleet.state() == MissionState.CANCELLED
 
@@ -952,8 +953,8 @@ def test_a_mission_cancelled_while_it_is_replanned_publishes_only_the_cancelling
     fleet.report('MARC1', RobotMode.FAILED)
     (request,) = kinds(fleet.tick(), Solve)
     assert fleet.state() == MissionState.REPLANNING
-    (cancelling,) = kinds(fleet.take(fleet.controller.cancel('operator stop', fleet.wall)),
-                          PublishPlan)
+    (cancelling,) = kinds(fleet.take(fleet.controller.cancel('m1', 'operator stop',
+                                                             fleet.wall)), PublishPlan)
     assert cancelling.cancelled and cancelling.revision == 2
     assert not fleet.run_solves([request])
     assert fleet.state() == MissionState.CANCELLED
@@ -967,7 +968,7 @@ def test_a_blocked_mission_can_be_cancelled(problem):
     fleet.tick()
     fleet.run_solves()
     assert fleet.state() == MissionState.BLOCKED
-    fleet.take(fleet.controller.cancel('operator stop', fleet.wall))
+    fleet.take(fleet.controller.cancel('m1', 'operator stop', fleet.wall))
     assert fleet.state() == MissionState.CANCELLED
     assert fleet.status().blocked == ('operator stop',)
 
@@ -1140,3 +1141,85 @@ def test_an_execution_state_the_tracker_cannot_tell_blocks_the_mission(problem):
     assert fleet.state() == MissionState.BLOCKED
     assert fleet.status().blocked == (
         "cannot tell the execution state: job 'Ja' ends before it starts",)
+
+
+# --- missions submitted while one runs: the queue -----------------------------------------
+
+def test_missions_submitted_while_one_runs_wait_their_turn_in_order(problem):
+    fleet = executing(problem)
+    assert fleet.controller.submit(problem, 'm2', fleet.wall) == (1, [])
+    assert fleet.controller.submit(problem, 'm3', fleet.wall) == (2, [])
+    assert fleet.status().queue == ('m2', 'm3')
+    assert fleet.controller.waiting('m3').state == MissionState.QUEUED
+    effects = fleet.take(fleet.controller.cancel('m2', 'not needed', fleet.wall))
+    assert effects == [LeftQueue('m2', MissionState.CANCELLED, ('not needed',))]
+    assert fleet.status().queue == ('m3',) and fleet.controller.position('m3') == 1
+    fleet.execute()
+    assert fleet.state() == MissionState.COMPLETE and fleet.controller.mission.id == 'm1'
+    fleet.following = {'location': 'Ad'}
+    effects = fleet.tick()
+    assert notes(effects, MissionEventKind.MISSION_STARTED)
+    assert fleet.controller.mission.id == 'm3' and fleet.status().queue == ()
+    (request,) = kinds(effects, Solve)
+    # The next mission starts where the last left the robots.
+    assert {r.start_location for r in request.problem.robots} == {'Ad'}
+    (published,) = kinds(fleet.run_solves([request]), PublishPlan)
+    assert published.revision == 1 and fleet.state() == MissionState.EXECUTING
+
+
+def test_a_mission_cancelled_with_a_queue_behind_it_hands_the_fleet_to_the_next(problem):
+    fleet = executing(problem)
+    fleet.controller.submit(problem, 'm2', fleet.wall)
+    fleet.take(fleet.controller.cancel('m1', 'operator stop', fleet.wall))
+    assert fleet.state() == MissionState.CANCELLED
+    fleet.tick()
+    assert fleet.controller.mission.id == 'm2'
+    assert fleet.state() in (MissionState.WAITING_FOR_ROBOTS, MissionState.PLANNING)
+
+
+def test_the_queue_is_bounded_and_optional(problem):
+    fleet = executing(problem, replace(SETTINGS, queue_limit=1))
+    with pytest.raises(ValueError, match="mission 'm1' is executing: one mission per fleet at "
+                                         r'a time \(the goal asked not to be queued\)'):
+        fleet.controller.submit(problem, 'm2', fleet.wall, queue=False)
+    fleet.controller.submit(problem, 'm2', fleet.wall)
+    with pytest.raises(ValueError, match=r'the queue is full: 1 missions wait their turn '
+                                         r'\(queue_limit 1\)'):
+        fleet.controller.submit(problem, 'm3', fleet.wall)
+    with pytest.raises(ValueError, match='one mission per fleet'):
+        fleet.controller.start(problem, 'm3', fleet.wall)
+    assert fleet.status().queue == ('m2',)
+
+
+def test_a_planner_without_a_queue_refuses_missions_while_one_runs(problem):
+    fleet = executing(problem, replace(SETTINGS, queue_limit=0))
+    with pytest.raises(ValueError, match="mission 'm1' is executing: one mission per fleet"):
+        fleet.controller.submit(problem, 'm2', fleet.wall)
+
+
+@pytest.mark.parametrize(('mission_id', 'why'), [
+    ('', "name the mission: the request has no mission id \\(running: 'm1'\\)"),
+    ('m0', "no mission 'm0' is running or waits in the queue \\(running: 'm1'\\)"),
+    ('m2', "mission 'm2' waits in the queue \\(position 1\\): it is not running yet"),
+])
+def test_a_request_must_name_the_mission_it_is_for(problem, mission_id, why):
+    fleet = executing(problem)
+    fleet.controller.submit(problem, 'm2', fleet.wall)
+    with pytest.raises(ValueError, match=why):
+        fleet.controller.running(mission_id)
+    if mission_id != 'm2':
+        with pytest.raises(ValueError, match=why):
+            fleet.controller.cancel(mission_id, 'stop', fleet.wall)
+    assert fleet.state() == MissionState.EXECUTING
+
+
+def test_a_planner_that_stands_down_fails_its_missions_and_publishes_no_plan(problem):
+    fleet = executing(problem)
+    fleet.controller.submit(problem, 'm2', fleet.wall)
+    effects = fleet.take(fleet.controller.stand_down('another planner is in charge'))
+    assert not kinds(effects, PublishPlan)
+    assert notes(effects, MissionEventKind.MISSION_FAILED)
+    assert kinds(effects, LeftQueue) == [LeftQueue('m2', MissionState.FAILED,
+                                                   ('another planner is in charge',))]
+    assert fleet.state() == MissionState.FAILED and not fleet.controller.busy
+    assert fleet.status().blocked == ('another planner is in charge',)

@@ -28,8 +28,10 @@ MISSION_TESTS = ('test_controller.py', 'test_out_of_step_reports.py')
 def test_every_state_has_an_entry_and_only_ended_missions_go_nowhere():
     assert set(TRANSITIONS) == set(MissionState)
     assert INITIAL == MissionState.WAITING_FOR_ROBOTS
-    # IDLE is the planner's state without a mission: no mission is ever in it.
-    assert not any(MissionState.IDLE in moves for moves in TRANSITIONS.values())
+    # IDLE is the planner's state without a mission: no mission is ever in it. A mission is
+    # queued when it is accepted, never later.
+    assert not any({MissionState.IDLE, MissionState.QUEUED} & moves
+                   for moves in TRANSITIONS.values())
     assert {s for s, moves in TRANSITIONS.items() if not moves} == {
         MissionState.IDLE, MissionState.COMPLETE, MissionState.CANCELLED, MissionState.FAILED}
 

@@ -35,6 +35,9 @@ class MissionRecord:
     goal): a restarted planner does not start a mission of the same origin again."""
     settings: dict
     accepted: float
+    queued: bool = False
+    """Accepted into the queue behind a running mission: it waits until a StartRecord
+    follows."""
 
 
 @dataclass(frozen=True)
@@ -75,7 +78,20 @@ class EndRecord:
     reasons: tuple[str, ...]
 
 
-Record = MissionRecord | PlanRecord | DoneRecord | JobsAddedRecord | EndRecord
+@dataclass(frozen=True)
+class StartRecord:
+    """A queued mission's turn came: it started at wall seconds `at`."""
+
+    at: float
+
+
+Record = MissionRecord | PlanRecord | DoneRecord | JobsAddedRecord | EndRecord | StartRecord
+
+
+def waits_in_queue(records: list[Record]) -> bool:
+    """Whether the journaled mission of `records` was queued, and neither started nor ended."""
+    return records[0].queued and not any(isinstance(r, StartRecord | EndRecord)
+                                         for r in records)
 
 
 class Journal:
@@ -153,7 +169,7 @@ def _encode(record: Record) -> dict:
         return {'type': 'mission', 'id': record.mission_id, 'scenario': record.scenario_yaml,
                 'name': record.scenario_name, 'panels': record.panels, 'shift': record.shift,
                 'origin': record.origin, 'settings': record.settings,
-                'accepted': record.accepted}
+                'accepted': record.accepted, 'queued': record.queued}
     if isinstance(record, PlanRecord):
         return {'type': 'plan', 'revision': record.revision, 'start': record.start,
                 'schedule': None if record.schedule is None else _schedule(record.schedule),
@@ -165,6 +181,8 @@ def _encode(record: Record) -> dict:
     if isinstance(record, JobsAddedRecord):
         return {'type': 'jobs_added', 'fragment': record.fragment_yaml,
                 'jobs': list(record.jobs)}
+    if isinstance(record, StartRecord):
+        return {'type': 'start', 'at': record.at}
     return {'type': 'end', 'state': record.state, 'reasons': list(record.reasons)}
 
 
@@ -173,7 +191,7 @@ def _decode(data: dict) -> Record:
     if kind == 'mission':
         return MissionRecord(data['id'], data['scenario'], data['name'], int(data['panels']),
                              float(data['shift']), data['origin'], dict(data['settings']),
-                             float(data['accepted']))
+                             float(data['accepted']), bool(data.get('queued', False)))
     if kind == 'plan':
         schedule = data['schedule']
         return PlanRecord(int(data['revision']), float(data['start']),
@@ -188,6 +206,8 @@ def _decode(data: dict) -> Record:
         return JobsAddedRecord(data['fragment'], tuple(data['jobs']))
     if kind == 'end':
         return EndRecord(data['state'], tuple(data['reasons']))
+    if kind == 'start':
+        return StartRecord(float(data['at']))
     raise ValueError(f'unknown record type {kind!r}')
 
 

@@ -8,12 +8,14 @@ story on `mission_events`, its summary on `mission_status` and per-job states on
 """
 
 import hashlib
+import itertools
 import math
 import os
 import secrets
 import sys
 import threading
 import time
+from collections import deque
 from concurrent.futures import Future, ThreadPoolExecutor
 from datetime import UTC, datetime
 from pathlib import Path
@@ -25,13 +27,16 @@ from rclpy.task import Future as RosFuture
 from rclpy.time import Time
 
 from fjsp_common.auth import NodeAuth
+from fjsp_common.clock import seconds
 from fjsp_common.contract import (
     ADD_JOBS_SERVICE,
     CANCEL_MISSION_SERVICE,
     DIAGNOSTICS,
     EVENT_FROM_MSG,
+    EVENT_HISTORY,
     JOB_STATES,
     JOB_STATES_TOPIC,
+    MAX_FLEET,
     MISSION_EVENT_TO_MSG,
     MISSION_EVENTS,
     MISSION_EVENTS_TOPIC,
@@ -43,6 +48,7 @@ from fjsp_common.contract import (
     ROBOT_STATES,
     ROBOT_STATES_TOPIC,
     RUN_MISSION_ACTION,
+    STATE_FROM_MSG,
     STATE_TO_MSG,
     TASK_EVENTS,
     TASK_EVENTS_TOPIC,
@@ -64,12 +70,16 @@ from fjsp_planner.execution.journal import (
     Journal,
     MissionRecord,
     PlanRecord,
+    StartRecord,
     journal_path,
     journals,
+    waits_in_queue,
 )
+from fjsp_planner.execution.mission.charge import Change, Charge, Role
 from fjsp_planner.execution.mission.controller import MissionController
 from fjsp_planner.execution.mission.effects import (
     JobDone,
+    LeftQueue,
     Note,
     PublishPlan,
     ResendPlan,
@@ -81,13 +91,17 @@ from fjsp_planner.execution.mission.settings import PARAMETERS, SETTINGS_PARAMET
 from fjsp_planner.execution.replan import improve, repair
 from fjsp_planner.execution.tracking import Ignored
 from fjsp_planner.model.extension import extend
-from fjsp_planner.model.problem import ProblemError
+from fjsp_planner.model.problem import Problem, ProblemError
 from fjsp_planner.model.scenario import load_scenario, scenario_from_text, scenario_warnings
 from fjsp_planner.nodes.conversions import cancel_msg, job_states, plan_msg
 from fjsp_planner.solving.solve import solve
 
 ANSWERS_KEPT = 256
 """Answers kept per service for requests that are resent."""
+
+WITHDRAW_GRACE = 1.0
+"""Seconds a planner that stood down keeps serving, so the goals it failed get their
+results."""
 
 SOLVER_NICENESS = 10
 
@@ -114,6 +128,11 @@ ENDINGS = {
     MissionEventKind.MISSION_CANCELLED: MissionState.CANCELLED,
     MissionEventKind.MISSION_FAILED: MissionState.FAILED,
 }
+RESULT_OF = {
+    MissionState.COMPLETE: RunMission.Result.STATE_COMPLETE,
+    MissionState.CANCELLED: RunMission.Result.STATE_CANCELLED,
+    MissionState.FAILED: RunMission.Result.STATE_FAILED,
+}
 
 
 def origin_of(text: str, panels: int, shift: float) -> str:
@@ -123,8 +142,8 @@ def origin_of(text: str, panels: int, shift: float) -> str:
 
 
 class Goal:
-    """A RunMission goal whose mission runs: answered when the mission ends, or when a resent
-    goal takes the mission over (`ended` then holds None)."""
+    """A RunMission goal whose mission runs or waits its turn: answered with its result when
+    the mission ends, or None when a resent goal takes the mission over."""
 
     def __init__(self, handle, mission_id: str):
         self.handle = handle
@@ -161,7 +180,9 @@ class PlannerNode(Node):
         self.time_scale, self.start_delay = value['time_scale'], value['start_delay']
         status_period, journal_dir = value['status_period'], value['journal_dir']
         self.journal_dir = Path(journal_dir).expanduser() if journal_dir else None
-        problem = None
+        self.startup = None
+        """The `scenario` parameter's mission, started once this planner takes charge:
+        (problem, text, file, panels, shift, origin)."""
         if scenario:
             try:
                 problem = load_scenario(scenario, panels=panels or None,
@@ -171,12 +192,14 @@ class PlannerNode(Node):
                 problems = getattr(error, 'problems', [str(error)])
                 raise ParameterError(f"parameter 'scenario': cannot use '{scenario}':\n"
                                      + '\n'.join(problems)) from None
-            origin = origin_of(text, panels, shift)
+            self.startup = (problem, text, scenario, panels, shift,
+                            origin_of(text, panels, shift))
 
         self.auth = NodeAuth(self, PLANNER_NODE)
         self.controller = MissionController(self.settings())
         self.journal: Journal | None = None
-        self.goal: Goal | None = None
+        self.goals: dict[str, Goal] = {}
+        """The RunMission goals of missions running or queued, by mission id."""
         self.job_done_ids: set[str] = set()
         self.solver_answer: tuple[str, float | None] = ('', None)
         """Status and gap of the latest plan's solve."""
@@ -201,41 +224,122 @@ class PlannerNode(Node):
         """Set under `waking` once the node is being destroyed: a solve ending then has no
         guard condition left to trigger."""
 
+        self.charge = Charge(self.incarnation, self.wall(), value['rival_timeout'])
+        self.started_up = False
+        self.servers: list | None = None
+        """The action server and services of mission requests, while this planner serves."""
+        self.withdraw_at: float | None = None
+        """Wall seconds when a planner that stood down withdraws its servers, once its
+        goals have had their answers."""
+        self.unheard: dict[str, deque] = {}
+        """Robot -> the task events heard while this planner was not in charge (as many as
+        its agent keeps for late joiners), with their order of arrival: a journal's mission
+        resumed once it takes charge must know what the robots did meanwhile."""
+        self.arrivals = itertools.count()
+        self.make_publishers()
+        subscription(self, ROBOT_STATES, self.on_robot_state)
+        subscription(self, TASK_EVENTS, self.on_event)
+        subscription(self, PLAN, self.on_plan)
+        subscription(self, MISSION_STATUS, self.on_status)
+        self.create_timer(0.1, self.tick)
+        self.create_timer(status_period, self.publish_periodic)
+        self.create_timer(DIAGNOSTICS_PERIOD, self.publish_diagnostics)
+        self.get_logger().info(f"listening for another planner on this ROS domain for "
+                               f"{value['rival_timeout']:g} s before taking charge")
+
+    def make_publishers(self) -> None:
+        """Fresh writers of every topic the planner publishes: a planner that stood down
+        leaves nothing latched for late joiners."""
+        for name in ('plan_pub', 'status_pub', 'jobs_pub', 'event_pub', 'story_pub',
+                     'diagnostics_pub'):
+            if hasattr(self, name):
+                self.destroy_publisher(getattr(self, name))
         self.plan_pub = publisher(self, PLAN)
         self.status_pub = publisher(self, MISSION_STATUS)
         self.jobs_pub = publisher(self, JOB_STATES)
         self.event_pub = publisher(self, TASK_EVENTS)
         self.story_pub = publisher(self, MISSION_EVENTS)
-        subscription(self, ROBOT_STATES, self.on_robot_state)
-        subscription(self, TASK_EVENTS, self.on_event)
-        subscription(self, PLAN, self.on_plan)
         self.diagnostics_pub = publisher(self, DIAGNOSTICS)
-        self.create_timer(0.1, self.tick)
-        self.create_timer(status_period, self.publish_periodic)
-        self.create_timer(DIAGNOSTICS_PERIOD, self.publish_diagnostics)
-        ActionServer(self, RunMission, RUN_MISSION_ACTION, self.execute_goal,
-                     goal_callback=lambda _: GoalResponse.ACCEPT,
-                     cancel_callback=self.cancel_goal)
-        self.create_service(AddJobs, ADD_JOBS_SERVICE, self.answer_once(self.on_add_jobs))
-        self.create_service(CancelMission, CANCEL_MISSION_SERVICE,
-                            self.answer_once(self.on_cancel))
 
+    def start_up(self) -> None:
+        """What a planner does once it first takes charge: resume what its journal left
+        unfinished, start the `scenario` parameter's mission."""
         resumed = self.resume_unfinished()
-        if problem is None:
+        log = self.get_logger()
+        if self.startup is None:
             if not resumed:
-                self.get_logger().info('no scenario given: waiting for RunMission goals')
-        elif resumed == origin or self.ran_before(origin):
-            self.get_logger().info(f"not starting '{scenario}' again: its mission is in the "
-                                   'journal (resumed or ended)')
+                log.info('no scenario given: waiting for RunMission goals')
+            return
+        problem, text, scenario, panels, shift, origin = self.startup
+        if resumed == origin or self.ran_before(origin):
+            log.info(f"not starting '{scenario}' again: its mission is in the journal "
+                     '(resumed or ended)')
         elif resumed:
-            self.get_logger().warning(f"not starting '{scenario}': the resumed mission "
-                                      'runs on this fleet')
+            log.warning(f"not starting '{scenario}': the resumed mission runs on this fleet")
         else:
-            self.get_logger().info(f"scenario '{problem.name}' from {scenario}: "
-                                   f'{len(problem.jobs)} jobs, robots '
-                                   + ', '.join(r.name for r in problem.robots))
-            self.start_mission(problem, text, problem.name, panels, shift, origin,
-                               self.settings())
+            log.info(f"scenario '{problem.name}' from {scenario}: {len(problem.jobs)} jobs, "
+                     'robots ' + ', '.join(r.name for r in problem.robots))
+            self.submit_mission(problem, text, problem.name, panels, shift, origin,
+                                self.settings())
+
+    # --- who is in charge ------------------------------------------------------------------
+
+    @property
+    def speaking(self) -> bool:
+        """In charge: it publishes what it decides. Listening or standing by, it is silent."""
+        return self.charge.role == Role.IN_CHARGE
+
+    def on_status(self, msg: MissionStatus) -> None:
+        if msg.auth.sender == PLANNER_NODE and msg.auth.incarnation == self.incarnation:
+            return  # its own
+        if not self.auth.accept(msg, MISSION_STATUS_TOPIC, {PLANNER_NODE}):
+            return
+        state = STATE_FROM_MSG.get(msg.state)
+        busy = bool(msg.queue) or (state is not None and state != MissionState.IDLE
+                                   and not state.ended)
+        self.charge.hear(msg.auth.incarnation, busy, msg.mission_id, seconds(msg.stamp),
+                         self.wall())
+
+    def take_role(self, change: Change) -> None:
+        log = self.get_logger()
+        if change.role == Role.IN_CHARGE:
+            log.warning(f'in charge of the fleet: {change.why}')
+            self.serve()
+            if not self.started_up:
+                self.started_up = True
+                self.start_up()
+            self.use_unheard()
+            self.publish_status()
+            return
+        leader = self.charge.leader()
+        log.warning(f'standing by: {change.why}. This planner serves no mission request and '
+                    'publishes nothing until it has heard no other planner for '
+                    f'{self.charge.timeout:g} s')
+        spoke = self.servers is not None
+        self.carry_out(self.controller.stand_down(f'another planner is in charge: {leader}'))
+        if spoke:
+            self.withdraw_at = self.wall() + WITHDRAW_GRACE
+            self.make_publishers()
+
+    def serve(self) -> None:
+        self.withdraw_at = None
+        if self.servers is not None:
+            return
+        self.servers = [
+            ActionServer(self, RunMission, RUN_MISSION_ACTION, self.execute_goal,
+                         goal_callback=lambda _: GoalResponse.ACCEPT,
+                         cancel_callback=self.cancel_goal),
+            self.create_service(AddJobs, ADD_JOBS_SERVICE, self.answer_once(self.on_add_jobs)),
+            self.create_service(CancelMission, CANCEL_MISSION_SERVICE,
+                                self.answer_once(self.on_cancel))]
+
+    def withdraw(self) -> None:
+        """Serve mission requests no more: clients reach only the planner in charge."""
+        action, *services = self.servers
+        action.destroy()
+        for service in services:
+            self.destroy_service(service)
+        self.servers = self.withdraw_at = None
 
     # --- parameters and time -------------------------------------------------------------
 
@@ -248,47 +352,68 @@ class PlannerNode(Node):
 
     # --- missions --------------------------------------------------------------------------
 
-    def start_mission(self, problem, text, name, panels, shift, origin, settings) -> str:
-        """Start a mission (ValueError while another one runs); its id."""
+    def submit_mission(self, problem, text, name, panels, shift, origin, settings,
+                       queue: bool = True) -> tuple[str, int]:
+        """Start a mission, or queue it behind the running one unless `queue` is False
+        (ValueError saying why if it cannot be taken); its id and place in the queue (0:
+        started)."""
         mission_id = new_mission_id(problem.name)
-        effects = self.controller.start(problem, mission_id, self.wall(), settings)
+        position, effects = self.controller.submit(problem, mission_id, self.wall(), settings,
+                                                   queue)
         if self.journal_dir is not None:
-            self.journal = Journal(journal_path(self.journal_dir, mission_id))
-            self.journal.write(MissionRecord(
-                mission_id, text, name, panels, shift, origin, settings.__dict__, self.wall()))
-        self.get_logger().info(f"mission '{mission_id}' accepted")
+            journal = Journal(journal_path(self.journal_dir, mission_id))
+            journal.write(MissionRecord(mission_id, text, name, panels, shift, origin,
+                                        settings.__dict__, self.wall(), queued=position > 0))
+            if position:
+                journal.close()
+            else:
+                self.journal = journal
+        self.get_logger().info(f"mission '{mission_id}' accepted"
+                               + (f', queued at position {position}' if position else ''))
         for warning in scenario_warnings(problem):
             self.get_logger().warning(f'scenario {problem.name!r}: {warning}')
         self.carry_out(effects)
-        return mission_id
+        return mission_id, position
+
+    def begin(self) -> None:
+        """The controller's mission has just started: a queued one's journal says so."""
+        mission = self.controller.mission
+        if self.journal_dir is None:
+            return
+        path = journal_path(self.journal_dir, mission.id)
+        if self.journal is not None and self.journal.path == path:
+            return
+        self.journal = Journal(path)
+        self.journal.write(StartRecord(self.wall()))
+        self.get_logger().info(f"mission '{mission.id}' starts: its turn in the queue came")
 
     def resume_unfinished(self) -> str:
-        """Resume the newest mission a previous planner left unfinished; its origin ('' if
-        none). Older unfinished ones are closed as abandoned."""
+        """Resume the newest mission a previous planner left running, and queue again the
+        missions it left waiting; the resumed one's origin ('' if none). Older unfinished
+        ones are closed as abandoned."""
         if self.journal_dir is None:
             return ''
         unfinished = [(path, records) for path, records in journals(self.journal_dir)
                       if not isinstance(records[-1], EndRecord)]
-        if not unfinished:
-            return ''
+        started = [(path, records) for path, records in unfinished
+                   if not waits_in_queue(records)]
+        origin = self.resume(started) if started else ''
+        self.requeue([(path, records) for path, records in unfinished
+                      if waits_in_queue(records)])
+        return origin
+
+    def resume(self, started) -> str:
         log = self.get_logger()
-        for path, _ in unfinished[:-1]:
-            with_end = Journal(path)
-            with_end.write(EndRecord('failed', ('abandoned: a newer mission was resumed',)))
-            with_end.close()
-        path, records = unfinished[-1]
+        for path, _ in started[:-1]:
+            close_journal(path, EndRecord('failed', ('abandoned: a newer mission was '
+                                                     'resumed',)))
+        path, records = started[-1]
         head: MissionRecord = records[0]
         try:
-            problem = scenario_from_text(head.scenario_yaml, head.scenario_name,
-                                         head.panels or None,
-                                         head.shift if head.shift >= 0 else None)
-            for record in records:
-                if isinstance(record, JobsAddedRecord):
-                    problem, _ = extend(problem, record.fragment_yaml)
+            problem, settings = self.journaled(records)
         except ProblemError as error:
             log.error(f'cannot resume the mission of {path}: ' + '; '.join(error.problems))
             return ''
-        settings = Settings(**{**self.settings().__dict__, **head.settings})
         self.journal = Journal(path)
         log.warning(f"resuming mission '{head.mission_id}' from {path}")
         self.carry_out(self.controller.resume(head.mission_id, problem, settings,
@@ -302,6 +427,31 @@ class PlannerNode(Node):
                 self.publish_done_event(record.event_id, head.mission_id, record.assignment.job,
                                         record.revision, float(record.assignment.end))
         return head.origin
+
+    def requeue(self, waiting) -> None:
+        """Queue again, in their order, the missions a previous planner left waiting."""
+        for path, records in waiting:
+            head: MissionRecord = records[0]
+            try:
+                problem, settings = self.journaled(records)
+            except ProblemError as error:
+                close_journal(path, EndRecord('failed', tuple(error.problems)))
+                continue
+            position = self.controller.requeue(problem, head.mission_id, head.accepted,
+                                               settings)
+            self.get_logger().warning(f"mission '{head.mission_id}' waits in the queue again "
+                                      f'(position {position}), from {path}')
+
+    def journaled(self, records) -> tuple[Problem, Settings]:
+        """The problem (with the jobs added to it) and settings of the mission journaled in
+        `records`; ProblemError if its scenario does not load any more."""
+        head: MissionRecord = records[0]
+        problem = scenario_from_text(head.scenario_yaml, head.scenario_name,
+                                     head.panels or None, head.shift if head.shift >= 0 else None)
+        for record in records:
+            if isinstance(record, JobsAddedRecord):
+                problem, _ = extend(problem, record.fragment_yaml)
+        return problem, Settings(**{**self.settings().__dict__, **head.settings})
 
     def publish_journaled_plan(self, mission_id: str) -> None:
         """Publish again the plan the previous process published last: killed while
@@ -332,11 +482,13 @@ class PlannerNode(Node):
 
     async def execute_goal(self, handle):
         goal = handle.request
-        if not self.auth.accept(goal, RUN_MISSION_ACTION):
-            return self.reject(handle, ['the goal is not signed with the fleet key'])
-        if goal.request_id and self.goal is not None \
-                and goal.request_id == self.goal.request_id:
-            return await self.take_over(handle)
+        why = self.auth.refusal(goal, RUN_MISSION_ACTION)
+        if why:
+            return self.reject(handle, [f'refused: {why}'])
+        resent = next((g for g in self.goals.values()
+                       if goal.request_id and g.request_id == goal.request_id), None)
+        if resent is not None:
+            return await self.take_over(handle, resent)
         try:
             problem, text, name = self.problem_of(goal)
         except ProblemError as error:
@@ -348,30 +500,44 @@ class PlannerNode(Node):
                 ('time_scale', goal.time_scale), ('blocked_timeout', goal.blocked_timeout))
             if value > 0}})
         try:
-            mission_id = self.start_mission(problem, text, name, goal.panels, goal.shift,
-                                            f'goal:{bytes(handle.goal_id.uuid).hex()}',
-                                            settings)
+            mission_id, _ = self.submit_mission(
+                problem, text, name, goal.panels, goal.shift,
+                f'goal:{bytes(handle.goal_id.uuid).hex()}', settings, queue=not goal.no_queue)
         except ValueError as error:
             return self.reject(handle, [str(error)])
-        self.goal = Goal(handle, mission_id)
+        self.goals[mission_id] = Goal(handle, mission_id)
         self.publish_feedback()
-        state = await self.goal.ended
-        return self.finish_goal(state) if state is not None else self.superseded(handle)
+        return await self.follow(self.goals[mission_id])
 
-    async def take_over(self, handle):
+    async def take_over(self, handle, superseded: 'Goal'):
         """A goal resent by a client that did not hear the first one accepted: it follows
         the mission the first one started, which answers no more."""
-        superseded, self.goal = self.goal, Goal(handle, self.goal.mission_id)
+        self.goals[superseded.mission_id] = Goal(handle, superseded.mission_id)
         superseded.ended.set_result(None)
         self.publish_feedback()
-        state = await self.goal.ended
-        return self.finish_goal(state) if state is not None else self.superseded(handle)
+        return await self.follow(self.goals[superseded.mission_id])
 
-    def superseded(self, handle) -> RunMission.Result:
-        handle.abort()
-        return RunMission.Result(state=RunMission.Result.STATE_REJECTED, makespan=math.nan,
-                                 planned_makespan=math.nan,
-                                 reasons=['superseded: the same request was sent again'])
+    async def follow(self, goal: 'Goal') -> RunMission.Result:
+        """The goal's result once its mission ends (or it is superseded)."""
+        ended = await goal.ended
+        if ended is None:
+            goal.handle.abort()
+            return RunMission.Result(state=RunMission.Result.STATE_REJECTED, makespan=math.nan,
+                                     planned_makespan=math.nan,
+                                     reasons=['superseded: the same request was sent again'])
+        if ended.state == RunMission.Result.STATE_COMPLETE:
+            goal.handle.succeed()
+        elif ended.state == RunMission.Result.STATE_CANCELLED \
+                and goal.handle.is_cancel_requested:
+            goal.handle.canceled()
+        else:
+            goal.handle.abort()
+        return ended
+
+    def answer_goal(self, mission_id: str, result: RunMission.Result) -> None:
+        goal = self.goals.pop(mission_id, None)
+        if goal is not None and not goal.ended.done():
+            goal.ended.set_result(result)
 
     def problem_of(self, goal):
         """The goal's scenario: (problem, YAML text, name); ProblemError if it has problems."""
@@ -407,25 +573,19 @@ class PlannerNode(Node):
                                  makespan=math.nan, planned_makespan=math.nan,
                                  reasons=list(reasons))
 
-    def finish_goal(self, state: MissionState) -> RunMission.Result:
-        goal, self.goal = self.goal, None
+    def result_of(self, state: MissionState) -> RunMission.Result:
+        """The result of the running mission, which ended in `state`."""
         view = self.controller.status(self.wall())
         complete = state == MissionState.COMPLETE
         if complete:
-            goal.handle.succeed()
             code = RunMission.Result.STATE_COMPLETE
         elif state == MissionState.CANCELLED:
-            if goal.handle.is_cancel_requested:
-                goal.handle.canceled()
-            else:
-                goal.handle.abort()
             code = RunMission.Result.STATE_CANCELLED
         else:
-            goal.handle.abort()
             code = (RunMission.Result.STATE_BLOCKED_TIMEOUT if view.blocked_too_long
                     else RunMission.Result.STATE_FAILED)
         return RunMission.Result(
-            mission_id=goal.mission_id, state=code,
+            mission_id=view.mission_id, state=code,
             makespan=view.projected_makespan if complete else math.nan,
             planned_makespan=view.planned_makespan, revisions=view.revision,
             jobs_done=view.jobs_done, jobs_total=view.jobs_total,
@@ -434,7 +594,9 @@ class PlannerNode(Node):
                 *decimals(view.projected_makespan, view.planned_makespan))])
 
     def cancel_goal(self, handle) -> CancelResponse:
-        if self.goal is None or self.goal.handle.goal_id != handle.goal_id:
+        goal = next((g for g in self.goals.values() if g.handle.goal_id == handle.goal_id),
+                    None)
+        if goal is None:
             return CancelResponse.REJECT
         if self.auth.enabled:
             # An action's cancel request carries nothing to sign: in an authenticated fleet,
@@ -442,7 +604,8 @@ class PlannerNode(Node):
             self.get_logger().warning('refusing an unsigned cancel of the RunMission goal: '
                                       f'use the {CANCEL_MISSION_SERVICE} service')
             return CancelResponse.REJECT
-        self.carry_out(self.controller.cancel('cancelled by the RunMission client',
+        self.carry_out(self.controller.cancel(goal.mission_id,
+                                              'cancelled by the RunMission client',
                                               self.wall()))
         return CancelResponse.ACCEPT
 
@@ -464,46 +627,44 @@ class PlannerNode(Node):
 
         return answer
 
+    def refused(self, service: str, request, response, why: str):
+        """`response` refusing `request`, with why; logged."""
+        response.success, response.message = False, why
+        self.get_logger().warning(f"{service} request of '{shorten(request.auth.sender, 80)}' "
+                                  f'refused: {shorten(why, 500)}')
+        return response
+
     def on_cancel(self, request, response):
-        if not self.auth.accept(request, CANCEL_MISSION_SERVICE, service=True):
-            response.success = False
-            response.message = 'refused: the request is not signed with the fleet key'
-            return response
-        mission = self.controller.mission
-        if request.mission_id and (mission is None or request.mission_id != mission.id):
-            response.success = False
-            response.message = (f"no mission '{shorten(request.mission_id, 80)}' runs"
-                                + (f" (running: '{mission.id}')" if mission is not None
-                                   and not mission.state.ended else ''))
-            return response
+        why = self.auth.refusal(request, CANCEL_MISSION_SERVICE, service=True)
+        if why:
+            return self.refused(CANCEL_MISSION_SERVICE, request, response, f'refused: {why}')
+        queued = self.controller.position(request.mission_id) > 0
         try:
-            effects = self.controller.cancel(shorten(request.reason, 500) or 'cancelled',
+            effects = self.controller.cancel(request.mission_id,
+                                             shorten(request.reason, 500) or 'cancelled',
                                              self.wall())
         except ValueError as error:
-            response.success, response.message = False, str(error)
-            return response
+            return self.refused(CANCEL_MISSION_SERVICE, request, response, str(error))
         self.carry_out(effects)
-        response.success, response.message = True, f"mission '{mission.id}' cancelled"
+        response.success = True
+        response.message = f"mission '{request.mission_id}' " + (
+            'taken out of the queue' if queued else 'cancelled')
         return response
 
     def on_add_jobs(self, request, response):
-        mission = self.controller.mission
-        response.success = False
-        if not self.auth.accept(request, ADD_JOBS_SERVICE, service=True):
-            response.message = 'refused: the request is not signed with the fleet key'
-            return response
-        if mission is None or mission.state.ended:
-            response.message = 'no mission is running'
-            return response
-        if request.mission_id and request.mission_id != mission.id:
-            response.message = (f"mission '{shorten(request.mission_id, 80)}' is not the "
-                                f"running mission '{mission.id}'")
-            return response
+        why = self.auth.refusal(request, ADD_JOBS_SERVICE, service=True)
+        if why:
+            return self.refused(ADD_JOBS_SERVICE, request, response, f'refused: {why}')
+        try:
+            mission = self.controller.running(request.mission_id)
+        except ValueError as error:
+            return self.refused(ADD_JOBS_SERVICE, request, response, str(error))
         tracker = mission.tracker
         try:
             problem, jobs = extend(mission.problem, request.fragment_yaml,
                                    tracker.done | tracker.running)
         except ProblemError as error:
+            response.success = False
             response.message = f'{len(error.problems)} problem(s); the mission is unchanged'
             response.problems = [shorten(p, 500) for p in error.problems]
             return response
@@ -518,9 +679,15 @@ class PlannerNode(Node):
 
     def tick(self) -> None:
         self.controller.settings = self.settings()
+        wall = self.wall()
+        change = self.charge.update(self.controller.busy, wall)
+        if change is not None:
+            self.take_role(change)
+        if self.withdraw_at is not None and wall >= self.withdraw_at:
+            self.withdraw()
         if self.journal is not None:
             self.journal.sync()
-        self.carry_out(self.controller.tick(self.wall(), self.plan_pub.get_subscription_count()))
+        self.carry_out(self.controller.tick(wall, self.plan_pub.get_subscription_count()))
 
     def on_robot_state(self, msg: RobotState) -> None:
         if not self.auth.accept(msg, ROBOT_STATES_TOPIC, {msg.robot}):
@@ -544,6 +711,25 @@ class PlannerNode(Node):
         senders = {PLANNER_NODE} if msg.kind == TaskEvent.KIND_JOB_DONE else {msg.robot}
         if not self.auth.accept(msg, TASK_EVENTS_TOPIC, senders):
             return
+        if self.speaking:
+            self.use_event(msg)
+            return
+        history = self.unheard.get(msg.robot)
+        if history is None and len(self.unheard) < MAX_FLEET:
+            history = self.unheard[msg.robot] = deque(maxlen=EVENT_HISTORY)
+        if history is not None:
+            history.append((next(self.arrivals), msg))
+
+    def use_unheard(self) -> None:
+        """Give the controller the task events heard while this planner was not in charge,
+        in their order."""
+        unheard = sorted((item for history in self.unheard.values() for item in history),
+                         key=lambda item: item[0])
+        self.unheard = {}
+        for _, msg in unheard:
+            self.use_event(msg)
+
+    def use_event(self, msg: TaskEvent) -> None:
         kind = EVENT_FROM_MSG.get(msg.kind)
         if kind is None:
             self.ignore(Ignored.UNKNOWN, f"event '{shorten(msg.event_id)}': kind {msg.kind} "
@@ -558,8 +744,9 @@ class PlannerNode(Node):
         self.carry_out(effects)
 
     def on_plan(self, msg: Plan) -> None:
-        if (msg.mission_id, msg.revision, msg.stamp) == self.last_published:
-            return
+        if (msg.mission_id, msg.revision, msg.stamp) == self.last_published \
+                or not self.speaking:
+            return  # its own, or the plan of the planner in charge
         if not self.auth.accept(msg, PLAN_TOPIC, {PLANNER_NODE}):
             return
         current = self.controller.mission
@@ -636,20 +823,34 @@ class PlannerNode(Node):
             elif isinstance(effect, JobDone):
                 self.publish_job_done(effect)
             elif isinstance(effect, Note):
+                if effect.kind == MissionEventKind.MISSION_STARTED:
+                    self.begin()
                 self.tell(effect)
                 if effect.kind in ENDINGS:
                     self.end(ENDINGS[effect.kind], effect.reasons)
+            elif isinstance(effect, LeftQueue):
+                self.left_queue(effect)
         self.publish_jobs()
         self.publish_status()
 
     def end(self, state: MissionState, reasons) -> None:
+        """The running mission ended: its journal is closed and its goal answered."""
         if self.journal is not None:
             self.journal.write(EndRecord(str(state), tuple(reasons)))
             self.journal.close()
             plan_file(self.journal.path).unlink(missing_ok=True)
             self.journal = None
-        if self.goal is not None and not self.goal.ended.done():
-            self.goal.ended.set_result(state)
+        self.answer_goal(self.controller.mission.id, self.result_of(state))
+
+    def left_queue(self, effect: LeftQueue) -> None:
+        if self.journal_dir is not None:
+            close_journal(journal_path(self.journal_dir, effect.mission_id),
+                          EndRecord(str(effect.state), effect.reasons))
+        self.get_logger().warning(f"mission '{effect.mission_id}' left the queue, "
+                                  f'{effect.state}: ' + shorten('; '.join(effect.reasons), 500))
+        self.answer_goal(effect.mission_id, RunMission.Result(
+            mission_id=effect.mission_id, state=RESULT_OF[effect.state], makespan=math.nan,
+            planned_makespan=math.nan, reasons=list(effect.reasons)))
 
     def publish_plan(self, effect: PublishPlan) -> None:
         mission = self.controller.mission
@@ -729,6 +930,9 @@ class PlannerNode(Node):
     def tell(self, note: Note) -> None:
         mission = self.controller.mission
         wall = self.wall()
+        self.get_logger().info(shorten(describe(note), 2000))
+        if not self.speaking:
+            return
         self.event_count += 1
         self.story_pub.publish(self.auth.sign(MissionEvent(
             stamp=self.get_clock().now().to_msg(),
@@ -737,9 +941,10 @@ class PlannerNode(Node):
             plan_revision=mission.tracker.revision if note.revision is None else note.revision,
             time=max(self.controller.now_units(wall), 0.0), robot=note.robot, job=note.job,
             reasons=list(note.reasons)), MISSION_EVENTS_TOPIC))
-        self.get_logger().info(shorten(describe(note), 2000))
 
     def publish_diagnostics(self) -> None:
+        if not self.speaking:
+            return
         view = self.controller.status(self.wall())
         if view is None:
             self.diagnostics_pub.publish(diagnostic_array(
@@ -762,26 +967,39 @@ class PlannerNode(Node):
 
     def publish_jobs(self) -> None:
         mission = self.controller.mission
-        if mission is None or mission.tracker.plan is None:
+        if not self.speaking or mission is None or mission.tracker.plan is None:
             return
         self.jobs_pub.publish(self.auth.sign(JobStates(
             stamp=self.get_clock().now().to_msg(), mission_id=mission.id,
             plan_revision=mission.tracker.revision, jobs=job_states(mission.tracker)),
             JOB_STATES_TOPIC))
 
-    def publish_feedback(self) -> None:
-        view = self.controller.status(self.wall())
-        if self.goal is None or view is None or view.mission_id != self.goal.mission_id:
-            return
-        self.goal.handle.publish_feedback(RunMission.Feedback(
-            mission_id=view.mission_id, state=STATE_TO_MSG[view.state],
-            plan_revision=view.revision, jobs_done=view.jobs_done,
-            jobs_running=view.jobs_running, jobs_total=view.jobs_total,
-            planned_makespan=view.planned_makespan,
-            projected_makespan=view.projected_makespan, elapsed=view.elapsed,
-            reasons=list(view.blocked or view.replan_reasons)))
+    def publish_feedback(self, view=None) -> None:
+        """Feedback to each goal: its running mission's state, or its place in the queue."""
+        view = view or self.controller.status(self.wall())
+        for mission_id, goal in self.goals.items():
+            waiting = self.controller.waiting(mission_id)
+            if waiting is not None:
+                feedback = RunMission.Feedback(
+                    mission_id=mission_id, state=STATE_TO_MSG[MissionState.QUEUED],
+                    queue_position=self.controller.position(mission_id),
+                    jobs_total=len(waiting.problem.jobs), planned_makespan=math.nan,
+                    projected_makespan=math.nan)
+            elif view is not None and view.mission_id == mission_id:
+                feedback = RunMission.Feedback(
+                    mission_id=view.mission_id, state=STATE_TO_MSG[view.state],
+                    plan_revision=view.revision, jobs_done=view.jobs_done,
+                    jobs_running=view.jobs_running, jobs_total=view.jobs_total,
+                    planned_makespan=view.planned_makespan,
+                    projected_makespan=view.projected_makespan, elapsed=view.elapsed,
+                    reasons=list(view.blocked or view.replan_reasons))
+            else:
+                continue
+            goal.handle.publish_feedback(feedback)
 
     def publish_status(self) -> None:
+        if not self.speaking:
+            return
         view = self.controller.status(self.wall())
         if view is None:
             # Heard by `mission status`, monitors and recorders before any mission: they
@@ -791,7 +1009,7 @@ class PlannerNode(Node):
                 state=STATE_TO_MSG[MissionState.IDLE],
                 ignored_unauthenticated=self.auth.rejected), MISSION_STATUS_TOPIC))
             return
-        self.publish_feedback()
+        self.publish_feedback(view)
         ignored = view.ignored
         self.status_pub.publish(self.auth.sign(MissionStatus(
             stamp=self.get_clock().now().to_msg(), mission_id=view.mission_id,
@@ -801,8 +1019,8 @@ class PlannerNode(Node):
             planned_makespan=view.planned_makespan,
             projected_makespan=view.projected_makespan, elapsed=view.elapsed,
             blocked_reasons=list(view.blocked), replan_reasons=list(view.replan_reasons),
-            warnings=list(view.warnings), ignored_stale=ignored[Ignored.STALE],
-            ignored_duplicate=ignored[Ignored.DUPLICATE],
+            warnings=list(view.warnings), queue=list(view.queue),
+            ignored_stale=ignored[Ignored.STALE], ignored_duplicate=ignored[Ignored.DUPLICATE],
             ignored_unknown=ignored[Ignored.UNKNOWN],
             ignored_unauthenticated=self.auth.rejected), MISSION_STATUS_TOPIC))
 
@@ -813,6 +1031,13 @@ class PlannerNode(Node):
         if self.journal is not None:
             self.journal.close()
         return super().destroy_node()
+
+
+def close_journal(path: Path, end: EndRecord) -> None:
+    """End the journal of a mission that is not the running one."""
+    journal = Journal(path)
+    journal.write(end)
+    journal.close()
 
 
 def plan_file(journal: Path) -> Path:

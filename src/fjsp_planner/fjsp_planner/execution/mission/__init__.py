@@ -11,5 +11,6 @@
 - `liveness`: which robots' agents are live and follow the plan (heartbeats, availability,
   plan uptake);
 - `continuation`: which jobs a new plan revision lets go on rather than start afresh;
-- `resume`: a mission a restarted planner rebuilds from its journal.
+- `resume`: a mission a restarted planner rebuilds from its journal;
+- `charge`: which planner of a ROS domain is in charge, and which stand by.
 """

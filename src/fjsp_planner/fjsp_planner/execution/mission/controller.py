@@ -2,11 +2,14 @@
 mission is over.
 
 The planner node feeds a `MissionController` what it hears (robot states, task events:
-`reports`), what it is asked (start or cancel a mission, add jobs) and the passing of time
+`reports`), what it is asked (submit or cancel a mission, add jobs) and the passing of time
 (`tick`), and carries out the `effects` each call returns: run a solve off the executor,
 publish a plan, declare a job done, tell the story of the mission (`Note`). All times in are
 wall seconds of one clock (the ROS clock); schedule time is derived from the mission start and
 the time scale.
+
+One mission runs at a time; missions submitted meanwhile wait in a bounded queue, and the
+next starts at the first tick after the running one ended, from where the robots are.
 
 Which robots it plans for is `liveness`'s judgement: a robot takes part while it is available.
 The plan records, for each robot it counted on, the agent incarnation and failure count it
@@ -28,6 +31,7 @@ from fjsp_planner.execution.mission import continuation
 from fjsp_planner.execution.mission.effects import (
     Effect,
     JobDone,
+    LeftQueue,
     Note,
     PublishPlan,
     Solve,
@@ -147,29 +151,114 @@ class MissionController:
         self.settings = settings if settings is not None else Settings()
         self.liveness = Liveness()
         self.mission: Mission | None = None
+        """The running mission, or the last one that ran."""
+        self.queue: list[Mission] = []
+        """The missions waiting their turn, the next first."""
         self._tokens = 0
 
     # --- commands ------------------------------------------------------------------------
 
+    @property
+    def busy(self) -> bool:
+        """A mission runs, or waits its turn."""
+        return bool(self.queue) or (self.mission is not None and not self.mission.state.ended)
+
     def start(self, problem: Problem, mission_id: str, wall: float,
               settings: Settings | None = None) -> list[Effect]:
-        """Accept a mission; raises ValueError while another one runs."""
-        if self.mission is not None and not self.mission.state.ended:
-            raise ValueError(f"mission '{self.mission.id}' is {self.mission.state}: one "
-                             'mission per fleet at a time')
-        self.mission = Mission(mission_id, problem, settings or self.settings,
-                               MissionTracker(problem), wall)
+        """Accept a mission; raises ValueError while another one runs or waits."""
+        if self.busy:
+            raise ValueError(self._one_at_a_time())
+        return self._begin(Mission(mission_id, problem, settings or self.settings,
+                                   MissionTracker(problem), wall), wall)
+
+    def submit(self, problem: Problem, mission_id: str, wall: float,
+               settings: Settings | None = None, queue: bool = True
+               ) -> tuple[int, list[Effect]]:
+        """Accept a mission: at once if none runs (position 0), else at the end of the
+        queue (its position there, 1 for the next to run) unless `queue` is False.
+        ValueError saying why if it cannot be taken: the queue is full, or not wanted."""
+        if not self.busy:
+            return 0, self.start(problem, mission_id, wall, settings)
+        limit = self.settings.queue_limit
+        if not queue or limit == 0:
+            raise ValueError(self._one_at_a_time()
+                             + ('' if queue else ' (the goal asked not to be queued)'))
+        if len(self.queue) >= limit:
+            raise ValueError(f'the queue is full: {len(self.queue)} missions wait their turn '
+                             f'(queue_limit {limit})')
+        return self.requeue(problem, mission_id, wall, settings), []
+
+    def requeue(self, problem: Problem, mission_id: str, wall: float,
+                settings: Settings | None = None) -> int:
+        """Put a mission at the end of the queue, whatever its limit (a restarted planner
+        rebuilds its queue so); its position."""
+        self.queue.append(Mission(mission_id, problem, settings or self.settings,
+                                  MissionTracker(problem), wall, _state=MissionState.QUEUED))
+        return len(self.queue)
+
+    def _one_at_a_time(self) -> str:
+        running = self.mission if self.mission is not None and not self.mission.state.ended \
+            else self.queue[0]
+        return f"mission '{running.id}' is {running.state}: one mission per fleet at a time"
+
+    def _begin(self, mission: Mission, wall: float) -> list[Effect]:
+        self.mission = mission
+        problem = mission.problem
         robots = ', '.join(r.name for r in problem.robots)
         effects = [Note(MissionEventKind.MISSION_STARTED,
                         (f"scenario '{problem.name}': {len(problem.jobs)} jobs, robots "
                          f'{robots}',))]
         return effects + self.tick(wall)
 
-    def cancel(self, reason: str, wall: float) -> list[Effect]:
-        """Stop the running mission: the robots are told to drop their tasks."""
+    def _start_next(self, wall: float) -> list[Effect]:
+        """The first mission of the queue starts, its robot wait counted from now."""
+        mission = self.queue.pop(0)
+        mission.enter(MissionState.WAITING_FOR_ROBOTS)
+        mission.accepted = wall
+        return self._begin(mission, wall)
+
+    def running(self, mission_id: str) -> Mission:
+        """The running mission, which `mission_id` must name; ValueError saying why not."""
         mission = self.mission
-        if mission is None or mission.state.ended:
-            raise ValueError('no mission is running')
+        if mission is not None and mission_id == mission.id and not mission.state.ended:
+            return mission
+        raise ValueError(self._not_running(mission_id))
+
+    def position(self, mission_id: str) -> int:
+        """Where `mission_id` waits in the queue: 1 for the next to run; 0 if it does not."""
+        ids = [waiting.id for waiting in self.queue]
+        return ids.index(mission_id) + 1 if mission_id in ids else 0
+
+    def waiting(self, mission_id: str) -> Mission | None:
+        """The queued mission `mission_id`, if it waits."""
+        position = self.position(mission_id)
+        return self.queue[position - 1] if position else None
+
+    def _not_running(self, mission_id: str) -> str:
+        mission = self.mission
+        running = f" (running: '{mission.id}')" if mission is not None \
+            and not mission.state.ended else ''
+        if not mission_id:
+            return 'name the mission: the request has no mission id' + running
+        shown = mission_id[:80]  # as the request gave it: any length
+        position = self.position(mission_id)
+        if position:
+            return (f"mission '{shown}' waits in the queue (position {position}): it is not "
+                    'running yet' + running)
+        if mission is not None and mission_id == mission.id:
+            return f"mission '{shown}' has ended: {mission.state}"
+        return f"no mission '{shown}' is running or waits in the queue" + running
+
+    def cancel(self, mission_id: str, reason: str, wall: float) -> list[Effect]:
+        """Stop mission `mission_id`: if it runs, the robots are told to drop their tasks;
+        if it waits in the queue, it leaves the queue. ValueError if it does neither."""
+        position = self.position(mission_id)
+        if position:
+            waiting = self.queue.pop(position - 1)
+            waiting.enter(MissionState.CANCELLED)
+            waiting.failure = (reason,)
+            return [LeftQueue(waiting.id, MissionState.CANCELLED, (reason,))]
+        mission = self.running(mission_id)
         mission.solving = mission.improving = None
         mission.enter(MissionState.CANCELLED)
         mission.failure = (reason,)
@@ -179,6 +268,21 @@ class MissionController:
             mission.tracker.revision = revision
             effects.insert(0, PublishPlan(revision, mission.problem, None, frozenset(),
                                           (reason,), mission.start, cancelled=True))
+        return effects
+
+    def stand_down(self, reason: str) -> list[Effect]:
+        """Another planner is in charge: the running mission fails and the queued ones leave
+        the queue failed, with `reason`. No plan goes out: the robots follow the other."""
+        effects: list[Effect] = []
+        mission = self.mission
+        if mission is not None and not mission.state.ended:
+            mission.solving = mission.improving = None
+            effects += self._fail(mission, (reason,))
+        for waiting in self.queue:
+            waiting.enter(MissionState.FAILED)
+            waiting.failure = (reason,)
+            effects.append(LeftQueue(waiting.id, MissionState.FAILED, (reason,)))
+        self.queue = []
         return effects
 
     def add_jobs(self, problem: Problem, jobs: tuple[str, ...], wall: float) -> list[Effect]:
@@ -336,6 +440,8 @@ class MissionController:
         effects: list[Effect] = []
         if not starved:
             effects += self._check_heartbeats(wall)
+        if self.queue and (self.mission is None or self.mission.state.ended):
+            return effects + self._start_next(wall)
         mission = self.mission
         if mission is None or mission.state.ended or mission.solving is not None:
             return effects
@@ -776,5 +882,5 @@ class MissionController:
             len(tracker.done), len(tracker.running), len(tracker.jobs),
             mission.planned_makespan, projected, max(now_units, 0.0), blocked,
             mission.replan_reasons, self.warnings(wall), Counter(tracker.ignored),
-            mission.blocked_too_long)
+            mission.blocked_too_long, tuple(waiting.id for waiting in self.queue))
 

@@ -2,7 +2,8 @@
 
 Every call of `MissionController` returns the `Effect`s the node must carry out, in order: run a
 solve off the executor (`Solve`), publish a plan (`PublishPlan`) or publish the latest one
-again (`ResendPlan`), declare a job done (`JobDone`), tell the story of the mission (`Note`).
+again (`ResendPlan`), declare a job done (`JobDone`), tell the story of the mission (`Note`),
+answer for a queued mission that ended before its turn (`LeftQueue`).
 `StatusView` is the mission's summary the node publishes on `mission_status`.
 """
 
@@ -102,7 +103,16 @@ class ResendPlan:
     revision: int
 
 
-Effect = Solve | PublishPlan | JobDone | Note | ResendPlan
+@dataclass(frozen=True)
+class LeftQueue:
+    """A queued mission ended before its turn: its requester gets `state` and `reasons`."""
+
+    mission_id: str
+    state: MissionState
+    reasons: tuple[str, ...]
+
+
+Effect = Solve | PublishPlan | JobDone | Note | ResendPlan | LeftQueue
 
 
 @dataclass(frozen=True)
@@ -123,3 +133,5 @@ class StatusView:
     ignored: Counter
     blocked_too_long: bool
     """The mission failed because it stayed blocked beyond its `blocked_timeout`."""
+    queue: tuple[str, ...] = ()
+    """The missions waiting their turn, the next first."""

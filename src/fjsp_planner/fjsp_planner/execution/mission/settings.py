@@ -46,6 +46,12 @@ PARAMETERS = table(
                   low=0.01, high=60.0),
     ParameterSpec('journal_dir', '', 'directory of the mission journals that let a restarted '
                   'planner resume its mission; empty: no journal'),
+    ParameterSpec('rival_timeout', 3.0, 'seconds a planner listens for another planner on '
+                  'its ROS domain before it takes charge; a planner standing by takes charge '
+                  'once the one in charge has been silent this long', low=0.5, high=600.0),
+    ParameterSpec('queue_limit', 16, 'missions that may wait their turn behind the running '
+                  'one; 0: a goal sent while a mission runs is refused', low=0, high=1000,
+                  read_only=False),
 )
 """The planner node's parameters, in the order it declares them. Those not read-only are
 honoured when set at run time (read at each use)."""
@@ -76,6 +82,8 @@ class Settings:
     plan_uptake_timeout: float = _default('plan_uptake_timeout')
     """Seconds a robot that reports may stay on an older plan revision than the latest before
     it is planned without, until it reports the latest."""
+    queue_limit: int = _default('queue_limit')
+    """Missions that may wait in the queue behind the running one."""
 
     @classmethod
     def from_parameters(cls, values: Mapping[str, object]) -> 'Settings':

@@ -1,10 +1,11 @@
 """The states a mission goes through, and the one table of the moves between them.
 
-A mission is accepted WAITING_FOR_ROBOTS and ends COMPLETE, CANCELLED or FAILED (IDLE is the
-planner's state while it has no mission). `TRANSITIONS` lists every move the controller may
-make; `check_transition` refuses any other: an illegal move is a bug in the controller, not
-something the fleet did, so it raises. A mission not ended may stay where it is (a better
-plan is published while it is EXECUTING; a blocked mission is found blocked again).
+A mission is accepted WAITING_FOR_ROBOTS, or QUEUED behind the running one until its turn,
+and ends COMPLETE, CANCELLED or FAILED (IDLE is the planner's state while it has no mission).
+`TRANSITIONS` lists every move the controller may make; `check_transition` refuses any other:
+an illegal move is a bug in the controller, not something the fleet did, so it raises. A
+mission not ended may stay where it is (a better plan is published while it is EXECUTING; a
+blocked mission is found blocked again).
 """
 
 from collections.abc import Mapping
@@ -18,6 +19,11 @@ _ENDS = (MissionState.COMPLETE, MissionState.FAILED, MissionState.CANCELLED)
 
 TRANSITIONS: Mapping[MissionState, frozenset[MissionState]] = {
     MissionState.IDLE: frozenset(),
+    MissionState.QUEUED: frozenset({
+        MissionState.WAITING_FOR_ROBOTS,    # its turn: the missions before it ended
+        MissionState.CANCELLED,             # taken out of the queue
+        MissionState.FAILED,                # the planner stood down for another one
+    }),
     MissionState.WAITING_FOR_ROBOTS: frozenset({
         MissionState.PLANNING,      # every robot reported, or the robot wait is over
         MissionState.BLOCKED,       # the robots there cannot staff some job
