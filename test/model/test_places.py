@@ -12,10 +12,13 @@ from fjsp_planner.model.extension import extend
 from fjsp_planner.model.places import euclidean_distances
 from fjsp_planner.model.problem import ProblemError
 from fjsp_planner.model.scenario import (
+    load_scenario,
     parse_scenario,
     problem_mapping,
     repeat_panels,
 )
+
+from repo_paths import SCENARIOS
 
 
 def scenario(**changes) -> dict:
@@ -155,6 +158,15 @@ def test_a_fragment_cannot_move_a_place():
     with pytest.raises(ProblemError) as caught:
         extend(problem, text)
     assert "fragment: location 'site' is on the map already" in caught.value.problems
+
+
+def test_the_yard_is_a_map_with_a_road_round_the_pond():
+    problem = load_scenario(SCENARIOS / 'yard.yaml')
+    assert len(problem.coordinates['depot']) == 3
+    assert problem.distance('depot', 'gate') == 50                      # 30-40-50
+    assert problem.distance('depot', 'mount') == 75                     # given: not 60
+    assert problem.distance('mount', 'mast_head') == 12
+    assert problem.distance('pad', 'mast_head') == Fraction('51.419841')   # sqrt 2644
 
 
 def test_a_problem_refuses_coordinates_of_two_dimensions():
