@@ -9,6 +9,7 @@ import json
 import math
 import subprocess
 import time
+import urllib.request
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from mcap.reader import make_reader
@@ -217,9 +218,9 @@ def valid_pose(pose) -> bool:
             and math.isclose(q.z ** 2 + q.w ** 2, 1.0))
 
 
-def test_a_mission_on_a_map_is_recorded_for_foxglove(fjsp_fleet, tmp_path):
+def test_a_mission_on_a_map_is_recorded_for_foxglove_and_served(fjsp_fleet, tmp_path):
     """The yard's robots on its map: their poses and the map's markers in the recording,
-    as Foxglove reads them."""
+    as Foxglove reads them; and the live page, fetched as curl would, holds the mission."""
     out, port = tmp_path / 'out', free_port()
     fleet = fjsp_fleet(SCENARIOS / 'yard.yaml', time_scale=SLOW)
     robots = [r.name for r in fleet.problem.robots]
@@ -228,6 +229,12 @@ def test_a_mission_on_a_map_is_recorded_for_foxglove(fjsp_fleet, tmp_path):
     fleet.start_monitor(out_dir=out, web_port=port, exit_on_complete=True)
     assert wait_listening(port, 30), f'the monitor did not serve its page on port {port}'
     fleet.start()
+    wait_until_elapsed(fleet.observer, 5)
+    mission_id = fleet.observer.plans[0].mission_id
+    page = urllib.request.urlopen(f'http://127.0.0.1:{port}/', timeout=10).read().decode()
+    assert f'<span id="mission-id">{mission_id}</span>' in page
+    assert '<span id="state" class="state" data-state="executing">executing</span>' in page
+    assert all(f'<tr data-robot="{robot}">' in page for robot in robots)
     fleet.check_mission_complete(timeout=90)
     assert fleet.processes['monitor'].wait(timeout=60) == 0, fleet.log('monitor')
     assert fleet.stop('recorder')['recorder'] == 0, fleet.log('recorder')

@@ -1,5 +1,6 @@
-// The live mission page: keeps the parts the monitor publishes (server-sent events on
-// /events) and redraws the ones that changed. Plain DOM and SVG, no library.
+// The live mission page: draws the parts the server embedded in the page at once, then keeps
+// the parts the monitor publishes (server-sent events on /events) and redraws the ones that
+// changed. Plain DOM and SVG, no library.
 'use strict';
 
 const data = {};
@@ -326,4 +327,6 @@ function connect() {
 }
 
 window.addEventListener('resize', () => { renderTimeline(); renderMap(); });
+// What the server wrote into the page, drawn before the first update arrives.
+apply(JSON.parse($('initial-state').textContent));
 connect();
