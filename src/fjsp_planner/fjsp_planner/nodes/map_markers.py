@@ -20,7 +20,7 @@ PLACE_COLOUR = ColorRGBA(r=0.55, g=0.55, b=0.6, a=0.8)
 TEXT_COLOUR = ColorRGBA(r=0.1, g=0.1, b=0.1, a=1.0)
 MODE_COLOURS = {
     RobotMode.IDLE: ColorRGBA(r=0.2, g=0.65, b=0.2, a=1.0),
-    RobotMode.TRAVELLING: ColorRGBA(r=0.1, g=0.1, b=0.1, a=1.0),
+    RobotMode.TRAVELLING: ColorRGBA(r=1.0, g=0.5, b=0.05, a=1.0),
     RobotMode.WAITING: ColorRGBA(r=0.6, g=0.6, b=0.6, a=1.0),
     RobotMode.WORKING: ColorRGBA(r=0.12, g=0.47, b=0.71, a=1.0),
     RobotMode.HOLDING: ColorRGBA(r=0.25, g=0.41, b=0.88, a=1.0),

@@ -96,8 +96,9 @@ def _state(fleet: FleetHistory, mission: MissionHistory, robot: str) -> RobotSta
 
 
 def spread(robots: list[RobotOnMap]) -> dict[str, tuple[float, float]]:
-    """Unit offsets in x-y that set apart robots drawn at one spot, round a circle, so that
-    each stays visible ((0, 0) for a robot alone at its spot)."""
+    """Unit offsets in x-y that set apart robots drawn at one spot, from east over north to
+    west (the place's name goes below it), so that each stays visible ((0, 0) for a robot
+    alone at its spot)."""
     spots = defaultdict(list)
     for r in robots:
         if r.position is not None:
@@ -106,8 +107,9 @@ def spread(robots: list[RobotOnMap]) -> dict[str, tuple[float, float]]:
     offsets = {}
     for names in spots.values():
         for k, name in enumerate(names):
-            angle = 2 * math.pi * k / len(names)
-            offsets[name] = (math.cos(angle), math.sin(angle)) if len(names) > 1 else (0.0, 0.0)
+            angle = math.pi * k / (len(names) - 1) if len(names) > 1 else None
+            offsets[name] = (math.cos(angle), math.sin(angle)) if angle is not None \
+                else (0.0, 0.0)
     return offsets
 
 

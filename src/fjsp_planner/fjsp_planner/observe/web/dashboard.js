@@ -242,7 +242,7 @@ function renderMap() {
   const margin = 48, width = Math.max(box.clientWidth || 900, 400);
   const span = Math.max(maxX - minX, maxY - minY, 1e-9);
   const scale = Math.min((width - 2 * margin) / Math.max(maxX - minX, span / 4),
-    360 / Math.max(maxY - minY, span / 4));
+    440 / Math.max(maxY - minY, span / 4));
   const height = (maxY - minY) * scale + 2 * margin;
   const left = (width - (maxX - minX) * scale) / 2;
   const sx = (x) => left + (x - minX) * scale;
@@ -267,12 +267,19 @@ function renderMap() {
   }
   for (const r of m.robots) {
     if (r.x === undefined) continue;
-    const x = sx(r.x) + 13 * r.spread[0], y = sy(r) - 13 * r.spread[1];
+    // Robots at one spot sit round it (east over north to west); each name goes outward.
+    const [dx, dy] = r.spread;
+    const x = sx(r.x) + 16 * dx, y = sy(r) - 16 * dy;
     const doing = r.job ? ` on ${r.job}` : '';
     const where = r.destination ? `${r.location || '?'} \u2192 ${r.destination}` : r.location;
     chart.appendChild(svg('circle', {cx: x, cy: y, r: 8, class: 'robot', 'data-robot': r.robot,
       'data-mode': r.mode}, `${r.robot}: ${r.mode}${doing} at ${where}`));
-    chart.appendChild(svg('text', {x: x + 10, y: y - 8, class: 'robot-name'})).textContent = r.robot;
+    const alone = dx === 0 && dy === 0;
+    const anchor = alone || dx > 0.3 ? 'start' : dx < -0.3 ? 'end' : 'middle';
+    const label = svg('text', {x: x + (alone ? 10 : 11 * dx), y: alone ? y - 8 : y - 12 * dy + 4,
+      class: 'robot-name', 'text-anchor': anchor});
+    label.textContent = r.robot;
+    chart.appendChild(label);
   }
   box.replaceChildren(chart);
 }
