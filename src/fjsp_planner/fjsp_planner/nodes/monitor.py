@@ -96,8 +96,8 @@ def senders_of(msg) -> set[str]:
 
 
 class MonitorNode(Node):
-    def __init__(self):
-        super().__init__(MONITOR_NODE)
+    def __init__(self, context=None, parameter_overrides=None):
+        super().__init__(MONITOR_NODE, context=context, parameter_overrides=parameter_overrides)
         value = {name: declare(self, spec) for name, spec in PARAMETERS.items()}
         out_dir = value['out_dir']
         self.out_dir = Path(out_dir).expanduser() if out_dir else default_out_dir()
@@ -234,15 +234,15 @@ class MonitorNode(Node):
     # --- the map ---------------------------------------------------------------------
 
     def publish_map(self) -> None:
-        """The robots' poses and the map's markers, whenever a robot moved or changed mode."""
+        """The robots' poses and the map's markers, whenever a robot moved or changed mode;
+        once empty when the current mission has no map but an earlier one had, so that no
+        viewer keeps showing that one's robots."""
         current = self.fleet.current()
         if current is None:
             return
         places = fleet_map.places(current)
-        if not places:
-            return
-        robots = fleet_map.robots_on_map(self.fleet, current, time.time())
-        key = (current.mission_id, tuple(places.values()), tuple(robots))
+        robots = fleet_map.robots_on_map(self.fleet, current, time.time()) if places else []
+        key = (current.mission_id, tuple(places.values()), tuple(robots)) if places else None
         if key == self.published_map:
             return
         self.published_map = key
