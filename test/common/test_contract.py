@@ -9,10 +9,10 @@ from fjsp_common.contract import MAX_FLEET, ROBOT_STATES, TOPICS
 def test_every_topic_of_a_mission_is_in_the_table_once():
     assert [t.name for t in TOPICS] == ['plan', 'robot_states', 'task_events',
                                         'mission_events', 'mission_status', 'job_states',
-                                        '/diagnostics']
+                                        '/diagnostics', 'robot_poses', 'fleet_map']
     assert [t.type.__name__ for t in TOPICS] == ['Plan', 'RobotState', 'TaskEvent',
                                                  'MissionEvent', 'MissionStatus', 'JobStates',
-                                                 'DiagnosticArray']
+                                                 'DiagnosticArray', 'PoseArray', 'MarkerArray']
 
 
 def test_a_late_joiner_gets_the_latest_state_of_every_robot():

@@ -31,7 +31,7 @@ from repo_paths import PAPER
     (['run', 'fjsp_planner', 'fleet'], 2, 'the following arguments are required: scenario'),
     (['run', 'fjsp_planner', 'fleet', 'no_such_scenario'], 2,
      'no_such_scenario: no such scenario file (installed: antenna.yaml, habitat.yaml, '
-     'solar_panel.yaml, truss.yaml)'),
+     'solar_panel.yaml, truss.yaml, yard.yaml)'),
     (['run', 'fjsp_planner', 'fleet', 'truss', '--panels', '0'], 2,
      'argument --panels: must be > 0, got 0'),
     (['run', 'fjsp_planner', 'fleet', 'truss', '--time-scale', 'fast'], 2,

@@ -6,8 +6,10 @@ The mission runs at 0.1 s per schedule unit so that a failure lands mid-mission.
 """
 
 import json
+import math
 import subprocess
 import time
+import urllib.request
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from mcap.reader import make_reader
@@ -16,7 +18,8 @@ from fjsp_msgs.msg import MissionStatus
 from fjsp_planner.missions import MissionClient
 from fjsp_planner.observe.recording import RecordingError, read_recording
 
-from repo_paths import PAPER
+from browser import free_port, wait_listening
+from repo_paths import PAPER, SCENARIOS
 
 ROBOTS = ('Assembler', 'LSMS', 'MARC1', 'MARC2')
 
@@ -28,6 +31,11 @@ RECORDED = {'/plan': 'fjsp_msgs/msg/Plan', '/robot_states': 'fjsp_msgs/msg/Robot
             '/mission_status': 'fjsp_msgs/msg/MissionStatus',
             '/job_states': 'fjsp_msgs/msg/JobStates',
             '/diagnostics': 'diagnostic_msgs/msg/DiagnosticArray'}
+MAP = {'/robot_poses': 'geometry_msgs/msg/PoseArray',
+       '/fleet_map': 'visualization_msgs/msg/MarkerArray'}
+"""Recorded too, published only for a scenario with places on a map."""
+YARD_PLACES = {'depot': (0, 0, 0), 'gate': (30, 40, 0), 'mount': (60, 0, 0),
+               'mast_head': (60, 0, 12), 'pad': (30, -40, 0)}
 
 
 def start_fleet(fleet):
@@ -103,7 +111,7 @@ def test_recording_replays_into_the_history_the_monitor_built(fjsp_fleet, tmp_pa
         summary = reader.get_summary()
     channels = {c.topic: c for c in summary.channels.values()}
     types = {topic: summary.schemas[c.schema_id].name for topic, c in channels.items()}
-    assert types == RECORDED
+    assert types == {**RECORDED, **MAP}
     assert {c.message_encoding for c in channels.values()} == {'cdr'}
     counts = {topic: summary.statistics.channel_message_counts.get(c.id, 0)
               for topic, c in channels.items()}
@@ -199,3 +207,51 @@ def test_ros2_topic_list_and_echo(fjsp_fleet):
     assert 'Traceback' not in missing.stderr
     wrong = ros2('echo', '/mission_status', '--once', '--field', 'no_such_field')
     assert wrong.returncode == 1 and "has no field 'no_such_field'" in wrong.stderr
+
+
+def valid_pose(pose) -> bool:
+    """On the yard's map (its bounding box), facing along x-y: or nowhere (all NaN)."""
+    p, q = pose.position, pose.orientation
+    if all(math.isnan(v) for v in (p.x, p.y, p.z)):
+        return True
+    return (0 <= p.x <= 60 and -40 <= p.y <= 40 and 0 <= p.z <= 12 and q.x == q.y == 0
+            and math.isclose(q.z ** 2 + q.w ** 2, 1.0))
+
+
+def test_a_mission_on_a_map_is_recorded_for_foxglove_and_served(fjsp_fleet, tmp_path):
+    """The yard's robots on its map: their poses and the map's markers in the recording,
+    as Foxglove reads them; and the live page, fetched as curl would, holds the mission."""
+    out, port = tmp_path / 'out', free_port()
+    fleet = fjsp_fleet(SCENARIOS / 'yard.yaml', time_scale=SLOW)
+    robots = [r.name for r in fleet.problem.robots]
+    fleet.start_node('recorder', 'fjsp_planner', 'recorder',
+                     {'out_dir': out, 'file_name': 'yard.mcap', 'flush_period': 0.5})
+    fleet.start_monitor(out_dir=out, web_port=port, exit_on_complete=True)
+    assert wait_listening(port, 30), f'the monitor did not serve its page on port {port}'
+    fleet.start()
+    wait_until_elapsed(fleet.observer, 5)
+    mission_id = fleet.observer.plans[0].mission_id
+    page = urllib.request.urlopen(f'http://127.0.0.1:{port}/', timeout=10).read().decode()
+    assert f'<span id="mission-id">{mission_id}</span>' in page
+    assert '<span id="state" class="state" data-state="executing">executing</span>' in page
+    assert all(f'<tr data-robot="{robot}">' in page for robot in robots)
+    fleet.check_mission_complete(timeout=90)
+    assert fleet.processes['monitor'].wait(timeout=60) == 0, fleet.log('monitor')
+    assert fleet.stop('recorder')['recorder'] == 0, fleet.log('recorder')
+
+    recorded = list(read_recording(out / 'yard.mcap'))
+    poses = [m.message for m in recorded if m.topic == '/robot_poses']
+    maps = [m.message for m in recorded if m.topic == '/fleet_map']
+    assert {m.type_name for m in recorded if m.topic in MAP} == set(MAP.values())
+    assert poses and maps
+    assert all(p.header.frame_id == 'map' and len(p.poses) == len(robots) for p in poses)
+    assert all(valid_pose(pose) for p in poses for pose in p.poses)
+    spots = {(x, y, z) for x, y, z in YARD_PLACES.values()}
+    # Robots were seen on their legs, between places, and all end at one.
+    assert any((pose.position.x, pose.position.y, pose.position.z) not in spots
+               and not math.isnan(pose.position.x) for p in poses for pose in p.poses)
+    assert {(q.position.x, q.position.y, q.position.z) for q in poses[-1].poses} <= spots
+    for markers in maps:
+        assert markers.markers[0].action == 3       # DELETEALL: each is a whole picture
+        assert {m.text for m in markers.markers if m.ns == 'place_names'} == set(YARD_PLACES)
+    assert {m.text for m in maps[-1].markers if m.ns == 'robot_names'} == set(robots)

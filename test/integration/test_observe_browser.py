@@ -1,5 +1,7 @@
 """The live mission page in a real headless browser (Debian's Chromium through Selenium): a
-fleet runs, a robot fails mid-mission, and the page shows what a person watching it must see.
+fleet runs, a robot fails mid-mission, and the page shows what a person watching it must see;
+the robots move on the map of a scenario that has one, and the page draws the mission on
+first load, before its event stream says anything.
 """
 
 import pytest
@@ -7,7 +9,7 @@ import pytest
 from fjsp_msgs.msg import MissionStatus
 
 from browser import find_chromium, free_port, headless_browser, wait_listening
-from repo_paths import PAPER
+from repo_paths import PAPER, SCENARIOS
 
 ROBOTS = ('Assembler', 'LSMS', 'MARC1', 'MARC2')
 
@@ -88,3 +90,48 @@ def test_live_page_follows_a_mission_through_a_failure(fjsp_fleet, tmp_path):
         assert len(set(attributes(page, '#timeline rect.work.done', 'data-job'))) == 12
         errors = [e for e in page.get_log('browser') if e['level'] == 'SEVERE']
         assert not errors, errors
+
+
+def robot_marks(page) -> dict[str, tuple[float, float]]:
+    """Each robot on the map: where the page draws it."""
+    return page.execute_script(
+        'return Object.fromEntries([...document.querySelectorAll("#map circle.robot")]'
+        '.map(e => [e.dataset.robot, [+e.getAttribute("cx"), +e.getAttribute("cy")]]))')
+
+
+def test_the_map_shows_the_robots_moving_and_the_page_draws_on_first_load(fjsp_fleet,
+                                                                          tmp_path):
+    port = free_port()
+    fleet = fjsp_fleet(SCENARIOS / 'yard.yaml', time_scale=0.5)
+    robots = {r.name for r in fleet.problem.robots}
+    fleet.start_monitor(out_dir=tmp_path, web_port=port)
+    assert wait_listening(port, 30), f'the monitor did not serve its page on port {port}'
+    fleet.start()
+    with headless_browser() as page:
+        page.get(f'http://127.0.0.1:{port}/')
+        wait_page(page, lambda p: set(robot_marks(p)) == robots, 60, 'every robot on the map')
+        assert set(attributes(page, '#map circle.place', 'data-place')) == {
+            'depot', 'gate', 'mount', 'mast_head', 'pad'}
+        seen = {robot: {tuple(xy)} for robot, xy in robot_marks(page).items()}
+
+        def moved(p) -> bool:
+            for robot, xy in robot_marks(p).items():
+                seen[robot].add(tuple(xy))
+            return sum(len(spots) > 2 for spots in seen.values()) >= 2
+        # A robot on a leg is drawn along it, not only at its ends.
+        wait_page(page, moved, 30, 'two robots moving along their legs')
+
+        # A page whose event stream never answers still shows the mission, its robots on
+        # the map and its timeline: all of it came with the page.
+        page.execute_cdp_cmd('Network.enable', {})
+        page.execute_cdp_cmd('Network.setBlockedURLs', {'urls': ['*/events']})
+        page.get(f'http://127.0.0.1:{port}/')
+        fleet.wait_for(lambda o: o.plans, 30, 'the plan')
+        assert text(page, '#mission-id') == fleet.observer.plans[0].mission_id
+        # (On a loaded machine the mission may have ended meanwhile.)
+        assert text(page, '#state') in ('executing', 'complete')
+        assert set(robot_marks(page)) == robots
+        assert attributes(page, '#timeline rect.plan-first', 'class')
+        assert attributes(page, '#connection', 'data-state') != ['live']
+        page.execute_cdp_cmd('Network.setBlockedURLs', {'urls': []})
+        fleet.check_mission_complete(timeout=90)

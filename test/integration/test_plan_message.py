@@ -1,12 +1,13 @@
 """What a revision's plan message tells the agents, built from the domain core's objects."""
 
 import dataclasses
+from fractions import Fraction
 
 from fjsp_planner.model.scenario import load_scenario
-from fjsp_planner.nodes.conversions import plan_msg
+from fjsp_planner.nodes.conversions import cancel_msg, plan_msg
 from fjsp_planner.solving.solve import solve
 
-from repo_paths import PAPER
+from repo_paths import PAPER, SCENARIOS
 
 
 def test_a_revision_names_the_predecessors_done_before_it():
@@ -46,3 +47,22 @@ def test_every_robot_is_placed_where_the_plan_starts_it():
     msg = plan_msg(placed, without_marc2, result.schedule, result, 'mission', 2, 0.0, 1.0, None)
     assert {r.robot: r.start_location for r in msg.robots} == {
         'Assembler': 'Aa', 'LSMS': 'Aa', 'MARC1': 'Aa', 'MARC2': ''}
+
+
+def test_the_plan_carries_the_map_of_the_scenario():
+    """Every located place with its coordinates (a 2-D one at z = 0), in every revision; a
+    scenario of distances alone has no map."""
+    yard = load_scenario(SCENARIOS / 'yard.yaml')
+    result = solve(yard, time_limit=2, workers=1)
+    msg = plan_msg(yard, yard, result.schedule, result, 'mission', 1, 0.0, 1.0, None)
+    assert {p.name: (p.x, p.y, p.z) for p in msg.places} == {
+        'depot': (0, 0, 0), 'gate': (30, 40, 0), 'mount': (60, 0, 0),
+        'mast_head': (60, 0, 12), 'pad': (30, -40, 0)}
+    flat = dataclasses.replace(yard, coordinates={'depot': (Fraction('0.5'), Fraction(-2))})
+    assert [(p.name, p.x, p.y, p.z) for p in cancel_msg(flat, 'mission', 2, 0.0, 1.0,
+                                                        None).places] == [
+        ('depot', 0.5, -2.0, 0.0)]
+    paper = load_scenario(PAPER)
+    result = solve(paper, time_limit=2, workers=1)
+    assert list(plan_msg(paper, paper, result.schedule, result, 'mission', 1, 0.0, 1.0,
+                         None).places) == []

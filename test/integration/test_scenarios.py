@@ -13,7 +13,8 @@ from repo_paths import SCENARIOS
 PAPER_TYPES = {'Assembler', 'MARC', 'LSMS'}
 
 
-@pytest.mark.parametrize('scenario', ['truss.yaml', 'antenna.yaml', 'habitat.yaml'])
+@pytest.mark.parametrize('scenario', ['truss.yaml', 'antenna.yaml', 'habitat.yaml',
+                                      'yard.yaml'])
 def test_scenario_runs_to_completion(fjsp_fleet, scenario):
     fleet = fjsp_fleet(SCENARIOS / scenario, time_scale=0.05, planner={'time_limit': 10.0})
     problem = fleet.problem

@@ -50,11 +50,12 @@ def task(robot, job, start, end, continued=False, held=False, co_workers=(),
                        restarted_in=restarted_in if continued else 0)
 
 
-def plan(revision, published, tasks, reasons=(), mission=MISSION, makespan=10.0):
+def plan(revision, published, tasks, reasons=(), mission=MISSION, makespan=10.0, places=()):
     return PlanFact(stamp=at(published), mission_id=mission, revision=revision,
                     scenario_id='demo', mission_start=START, time_scale=1.0, cancelled=False,
                     makespan=makespan, solver_status='optimal', lower_bound=makespan,
-                    reasons=tuple(reasons), robots=ROBOTS, tasks=tuple(tasks))
+                    reasons=tuple(reasons), robots=ROBOTS, tasks=tuple(tasks),
+                    places=tuple(places))
 
 
 _count = iter(range(1, 1_000_000))
@@ -181,7 +182,8 @@ def as_message(fact) -> dict:
                      'co_workers': list(t.co_workers), 'predecessors': list(t.predecessors),
                      'held_into_next': t.held_into_next, 'continued': t.continued,
                      'restarted_in': t.restarted_in}
-                    for t in fact.tasks if t.robot == robot]} for robot, kind in fact.robots]}
+                    for t in fact.tasks if t.robot == robot]} for robot, kind in fact.robots],
+                'places': [{'name': p.name, 'x': p.x, 'y': p.y, 'z': p.z} for p in fact.places]}
     if isinstance(fact, TaskEventFact):
         return {'stamp': time(fact.stamp), 'event_id': fact.event_id,
                 'mission_id': fact.mission_id, 'kind': constant('TaskEvent', 'KIND', fact.kind),

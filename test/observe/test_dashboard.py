@@ -46,6 +46,22 @@ def test_the_data_is_there_as_json(dashboard):
     assert json.loads(response.read()) == {'mission': {'state': 'executing'}, 'robots': []}
 
 
+def test_a_plain_get_of_the_page_holds_the_mission(dashboard):
+    """What curl, a browser without JavaScript or a screenshot on load gets: the mission,
+    not an empty page waiting for its event stream."""
+    dashboard.publish({'mission': {'mission_id': 'yard-1', 'scenario': 'yard',
+                                   'state': 'executing', 'revision': 1, 'jobs_done': 2,
+                                   'jobs_total': 9},
+                       'robots': [{'robot': 'Truck1', 'type': 'Truck', 'mode': 'travelling',
+                                   'location': 'depot', 'destination': 'mount',
+                                   'progress': 0.5}]})
+    _, page = get(dashboard, '/')
+    html = page.read().decode()
+    assert '<span id="mission-id">yard-1</span>' in html
+    assert '<span id="jobs">2/9</span>' in html
+    assert '<tr data-robot="Truck1">' in html and 'depot \u2192 mount' in html
+
+
 def read_event(response) -> dict:
     lines = []
     while True:

@@ -24,7 +24,7 @@ def test_definitions_append_each_dependency_once_as_rosbag2_does():
     text = message_definition('fjsp_msgs/msg/Plan', READ_MSG)
     assert text.startswith((REPO / 'src/fjsp_msgs/msg/Plan.msg').read_text())
     sections = re.findall(rf'^{SEPARATOR}\nMSG: (\S+)$', text, re.M)
-    assert sorted(sections) == ['builtin_interfaces/Time', 'fjsp_msgs/Auth',
+    assert sorted(sections) == ['builtin_interfaces/Time', 'fjsp_msgs/Auth', 'fjsp_msgs/Place',
                                 'fjsp_msgs/PlanTask', 'fjsp_msgs/RobotPlan']
 
 

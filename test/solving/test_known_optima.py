@@ -31,6 +31,15 @@ def test_shipped_scenario_is_proven_optimal(scenario, optimum):
     assert validate(problem, result.schedule) == []
 
 
+def test_the_yard_map_is_planned_to_its_optimum_on_the_solver_grid():
+    """Its distances from coordinates are millionths, so CP-SAT rounds travel up onto its
+    1/1000 grid: it proves 46.175 optimal there, which bounds the exact optimum above."""
+    problem = load_scenario(SCENARIOS / 'yard.yaml')
+    result = solve(problem, time_limit=60, workers=2)
+    assert validate(problem, result.schedule) == []
+    assert result.makespan <= Fraction('46.175'), result
+
+
 def test_a_shipped_scenario_carries_a_held_part_between_two_places():
     problem = load_scenario(SCENARIOS / 'habitat.yaml')
     assert any(problem.job(a).location != problem.job(b).location

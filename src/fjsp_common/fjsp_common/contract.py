@@ -10,7 +10,9 @@ word without a constant (or the reverse) fails at import, not in a mission.
 from dataclasses import dataclass
 
 from diagnostic_msgs.msg import DiagnosticArray
+from geometry_msgs.msg import PoseArray
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+from visualization_msgs.msg import MarkerArray
 
 from fjsp_common.diagnostics import DIAGNOSTICS_QOS, DIAGNOSTICS_TOPIC
 from fjsp_common.vocabulary import EventKind, MissionEventKind, MissionState, RobotMode
@@ -22,6 +24,8 @@ JOB_STATES_TOPIC = 'job_states'
 TASK_EVENTS_TOPIC = 'task_events'
 MISSION_EVENTS_TOPIC = 'mission_events'
 MISSION_STATUS_TOPIC = 'mission_status'
+ROBOT_POSES_TOPIC = 'robot_poses'
+FLEET_MAP_TOPIC = 'fleet_map'
 INJECT_FAULT_SERVICE = 'inject_fault'
 """Served by each agent under its robot name: `<robot>/inject_fault`."""
 RUN_MISSION_ACTION = 'run_mission'
@@ -91,9 +95,13 @@ MISSION_EVENTS = Topic(MISSION_EVENTS_TOPIC, MissionEvent, EVENTS_QOS)
 MISSION_STATUS = Topic(MISSION_STATUS_TOPIC, MissionStatus, LATCHED_QOS)
 JOB_STATES = Topic(JOB_STATES_TOPIC, JobStates, LATCHED_QOS)
 DIAGNOSTICS = Topic(DIAGNOSTICS_TOPIC, DiagnosticArray, DIAGNOSTICS_QOS)
+ROBOT_POSES = Topic(ROBOT_POSES_TOPIC, PoseArray, LATCHED_QOS)
+"""The monitor's view of where each robot is on the mission's map (standard messages, for
+Foxglove and other tools)."""
+FLEET_MAP = Topic(FLEET_MAP_TOPIC, MarkerArray, LATCHED_QOS)
 
 TOPICS = (PLAN, ROBOT_STATES, TASK_EVENTS, MISSION_EVENTS, MISSION_STATUS, JOB_STATES,
-          DIAGNOSTICS)
+          DIAGNOSTICS, ROBOT_POSES, FLEET_MAP)
 """Every topic of a mission."""
 
 

@@ -3,6 +3,7 @@
 - `problem`: `Problem` and its parts, plain immutable data checked at construction;
 - `scenario`: YAML scenario files (docs/scenario-format.md) and N-panel repetition;
 - `fjs`: the classic FJSP benchmark text format;
+- `places`: locations on a map, and the Euclidean distances their coordinates imply;
 - `extension`: jobs added to a running mission, as a scenario fragment;
 - `limits`: how large and how extreme an input may be, checked before anything is built;
 - `schedule`: `Schedule` (exact times) and the solver-neutral `Result`;

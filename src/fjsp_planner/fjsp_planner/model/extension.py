@@ -1,7 +1,8 @@
 """Jobs added to a running mission, given as a scenario fragment.
 
-A fragment has the scenario format's `jobs` and, as needed, `distances` (between its new
-locations and any of the mission's), `precedence` and `holding` arcs (among its jobs, or from
+A fragment has the scenario format's `jobs` and, as needed, `locations` (coordinates of its
+new locations), `distances` (between its new locations and any of the mission's),
+`precedence` and `holding` arcs (among its jobs, or from
 and to the mission's). It is checked by building the whole extended scenario, so every rule
 of a scenario applies (unknown names, missing distances, cycles, unstaffable jobs) and every
 problem is reported at once. An arc into a job that has already started cannot hold any more,
@@ -15,7 +16,7 @@ import yaml
 from fjsp_planner.model.problem import Problem, ProblemError
 from fjsp_planner.model.scenario import parse_scenario, problem_mapping
 
-SECTIONS = ('jobs', 'distances', 'precedence', 'holding')
+SECTIONS = ('jobs', 'locations', 'distances', 'precedence', 'holding')
 
 
 def extend(problem: Problem, fragment: str, started: Collection[str] = ()
@@ -58,6 +59,14 @@ def extend(problem: Problem, fragment: str, started: Collection[str] = ()
                                + list(section.get('pairs') or [])}
     else:
         problems.append("fragment: 'distances' must be a mapping with 'table' and/or 'pairs'")
+    places = data.get('locations') or {}
+    if isinstance(places, dict):
+        problems += [f"fragment: location '{name}' is on the map already"
+                     for name in places if str(name) in problem.coordinates]
+        merged['locations'] = {**merged.get('locations', {}), **places}
+    else:
+        problems.append("fragment: 'locations' must be a mapping of location -> [x, y] or "
+                        '[x, y, z]')
     for key in ('precedence', 'holding'):
         if data.get(key) is not None:
             merged[key] = merged[key] + (data[key] if isinstance(data[key], list)

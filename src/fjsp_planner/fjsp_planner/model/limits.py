@@ -23,6 +23,9 @@ from fjsp_planner.model.problem import ProblemError
 
 MAX_TIME = Fraction(10**6)
 """Schedule units: every duration, derived travel time, release time and distance."""
+MAX_COORDINATE = Fraction(10**6)
+"""Of a location on the map, on each axis, either way; the distances its coordinates imply
+are held to MAX_TIME like any other."""
 MIN_SPEED = Fraction(1, 10**6)
 MAX_SPEED = Fraction(10**6)
 MAX_DENOMINATOR = 10**6

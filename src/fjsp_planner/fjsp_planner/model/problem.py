@@ -83,6 +83,9 @@ class Problem:
     copy matching; solvers may use this to break the symmetry between copies and to bound
     moves between them."""
     name: str = 'problem'
+    coordinates: Mapping[str, tuple[Fraction, ...]] = field(default_factory=dict)
+    """location -> where it is on the map, (x, y) or (x, y, z), the same for every location
+    given one. `distances` already hold the Euclidean distances they imply (`places`)."""
 
     def __post_init__(self):
         object.__setattr__(self, '_robot_by_name', {r.name: r for r in self.robots})
@@ -215,6 +218,10 @@ def _structural_problems(p: Problem) -> list[str]:
             problems.append(f"distance '{a}'-'{b}' is negative ({decimal(d)})")
     if p.locomote in p.operation_types:
         problems.extend(_missing_distances(p))
+    dimensions = {len(point) for point in p.coordinates.values()}
+    if dimensions - {2, 3} or len(dimensions) > 1:
+        problems.append('coordinates must all be (x, y) or all be (x, y, z); found '
+                        + ' and '.join(str(d) for d in sorted(dimensions)) + ' numbers')
     for a, b in p.precedence:
         for name in (a, b):
             if name not in jobs:
@@ -258,9 +265,10 @@ def _missing_distances(p: Problem) -> list[str]:
                 "'distances' must give one between every two of them"]
     named = {a for a, _ in p.distances} | {b for _, b in p.distances}
     unused = named - set(ordered)
-    missing = [f"location '{place}' ({_there(p, place)}) has no distance to any other "
-               'location' + suggestion(place, unused or named)
-               for place in ordered if place not in named]
+    # On a map, such a place most likely lacks its coordinates.
+    lacks = 'no coordinates and no distance' if p.coordinates else 'no distance'
+    missing = [f"location '{place}' ({_there(p, place)}) has {lacks} to any other location"
+               + suggestion(place, unused or named) for place in ordered if place not in named]
     placed = [place for place in ordered if place in named]
     for i, a in enumerate(placed):
         for b in placed[i + 1:]:

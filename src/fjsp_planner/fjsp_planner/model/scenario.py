@@ -15,7 +15,8 @@ import yaml
 
 from fjsp_common.decimals import decimals
 from fjsp_planner.model import limits
-from fjsp_planner.model.limits import MAX_TIME, shown
+from fjsp_planner.model.limits import MAX_COORDINATE, MAX_TIME, shown
+from fjsp_planner.model.places import euclidean_distances, on_grid, panel_coordinates
 from fjsp_planner.model.problem import Job, Problem, ProblemError, Robot, listed, suggestion
 
 DEFAULT_SHIFT = Fraction(60)
@@ -24,7 +25,7 @@ DEFAULT_SHIFT = Fraction(60)
 _LOADER = getattr(yaml, 'CSafeLoader', yaml.SafeLoader)
 
 SECTIONS = ('name', 'operation_types', 'locomote', 'robot_types', 'robots', 'jobs',
-            'distances', 'precedence', 'holding', 'time_overrides', 'panels')
+            'locations', 'distances', 'precedence', 'holding', 'time_overrides', 'panels')
 ROBOT_KEYS = ('name', 'type', 'speed', 'start_location', 'release_time')
 JOB_KEYS = ('name', 'location', 'plans')
 OVERRIDE_KEYS = ('robot', 'operation', 'time')
@@ -149,11 +150,14 @@ def repeat_panels(problem: Problem, panels: int, shift=DEFAULT_SHIFT) -> Problem
         Robot(r.name, r.type, r.speed,
               tag(r.start_location, 1) if r.start_location else None, r.release_time)
         for r in problem.robots)
+    used = {j.location for j in jobs} | {r.start_location for r in robots}
     return Problem(
         operation_types=problem.operation_types, robot_types=problem.robot_types,
         robots=robots, jobs=tuple(jobs), distances=distances, precedence=tuple(precedence),
         holding=tuple(holding), locomote=problem.locomote,
         time_overrides=problem.time_overrides, name=f'{problem.name} x{panels}',
+        coordinates={name: point for name, point in panel_coordinates(
+            problem.coordinates, panels, shift, tag).items() if name in used},
         panels=tuple(tuple(tag(j.name, k) for j in problem.jobs)
                      for k in range(1, panels + 1)))
 
@@ -361,7 +365,9 @@ def _from_mapping(data, default_name, panels=None, shift=None):
                 resolved.append(tuple(q for q in ops if q is not None))
         jobs.append(Job(name, location, tuple(resolved)))
 
-    distances = _distances(read, data.get('distances'))
+    coordinates = _locations(read, data.get('locations'), jobs, robots)
+    distances = {**_placed_distances(read, coordinates),
+                 **_distances(read, data.get('distances'))}
 
     def arcs(key, size):
         result = []
@@ -421,6 +427,7 @@ def _from_mapping(data, default_name, panels=None, shift=None):
             operation_types=operation_types, robot_types=robot_types, robots=tuple(robots),
             jobs=tuple(jobs), distances=distances, precedence=tuple(precedence),
             holding=tuple(holding), locomote=locomote, time_overrides=overrides,
+            coordinates=coordinates,
             name=read.attempt(lambda: limits.name(data['name'], 'name'), str(default_name))
             if 'name' in data else str(default_name))
     except ProblemError as error:
@@ -429,6 +436,82 @@ def _from_mapping(data, default_name, panels=None, shift=None):
     if read.problems:
         raise ProblemError(list(dict.fromkeys(read.problems)))
     return problem, file_panels
+
+
+def _locations(read, section, jobs, robots) -> dict:
+    """The `locations` section: each location's coordinates, read exactly. A location whose
+    coordinates cannot be read is left off the map, and its missing distances that follow
+    are not reported again."""
+    if section is None:
+        return {}
+    if not isinstance(section, dict):
+        read.problems.append("'locations' must be a mapping of location -> [x, y] or "
+                             '[x, y, z]')
+        return {}
+    most = limits.MAX_JOBS + limits.MAX_ROBOTS      # every job and start at its own place
+    if len(section) > most:
+        read.problems += limits.count_problem('locations', len(section), most)
+        return {}
+    used = {j.location for j in jobs} | {r.start_location for r in robots if r.start_location}
+    coordinates, unreadable = {}, set()
+    for key, point in section.items():
+        name = read.name(key, 'locations')
+        if name is None:
+            continue
+        what = f"location '{name}'"
+        if name not in used:
+            read.problems.append(f'{what} in locations: no job is there and no robot starts '
+                                 'there' + suggestion(name, used))
+            continue
+        if not isinstance(point, list) or len(point) not in (2, 3):
+            read.problems.append(f'{what}: coordinates must be [x, y] or [x, y, z], got '
+                                 f'{shown(point)}')
+            unreadable.add(name)
+            continue
+        values = tuple(read.attempt(lambda value=value, where=f'{what} {axis}': _coordinate(
+            value, where), None) for axis, value in zip('xyz', point, strict=False))
+        if None in values:
+            unreadable.add(name)
+        else:
+            coordinates[name] = values
+    dimensions = {}
+    for name, point in coordinates.items():
+        dimensions.setdefault(len(point), name)
+    if len(dimensions) > 1:
+        read.problems.append(f"locations: '{dimensions[2]}' has 2 coordinates (x, y) but "
+                             f"'{dimensions[3]}' has 3 (x, y, z); give every location the "
+                             'same number')
+        unreadable |= set(coordinates)
+        coordinates = {}
+    if unreadable:
+        read.consequences.add('no distances are given')
+    for name in unreadable:
+        read.consequences.update({f"location '{name}' (",
+                                  f"no distance between locations '{name}' and ",
+                                  f" and '{name}'"})
+    return coordinates
+
+
+def _coordinate(value, what) -> Fraction:
+    exact = limits.number(value, what, -MAX_COORDINATE, MAX_COORDINATE)
+    if not on_grid(exact):
+        raise ProblemError([f'{what}: {shown(value)} is not a whole number of millionths '
+                            '(coordinates take at most 6 decimal places)'])
+    return exact
+
+
+def _placed_distances(read, coordinates) -> dict:
+    """The Euclidean distances between placed locations; those beyond the distance limit are
+    reported (the farthest pair, and how many there are)."""
+    distances = euclidean_distances(coordinates)
+    far = [(d, a, b) for (a, b), d in distances.items() if d > MAX_TIME and a < b]
+    if far:
+        d, a, b = max(far)
+        more = f' ({len(far)} pairs are)' if len(far) > 1 else ''
+        read.problems.append(f"locations '{a}' and '{b}' are {float(d):g} apart by their "
+                             f'coordinates, more than the limit of {float(MAX_TIME):g} for a '
+                             f'distance{more}')
+    return distances
 
 
 def _distances(read, section):
@@ -538,6 +621,9 @@ def problem_mapping(problem: Problem) -> dict:
                     'release_time': str(r.release_time)} for r in problem.robots],
         'jobs': [{'name': j.name, 'location': j.location, 'plans': [list(p) for p in j.plans]}
                  for j in problem.jobs],
+        **({'locations': {name: [str(c) for c in point]
+                          for name, point in problem.coordinates.items()}}
+           if problem.coordinates else {}),
         'distances': {'pairs': [[a, b, str(d)] for (a, b), d in problem.distances.items()
                                 if a < b]},
         'precedence': [list(arc) for arc in problem.precedence],

@@ -2,7 +2,7 @@
 
 import math
 
-from fjsp_msgs.msg import JobState, Plan, PlanTask, RobotPlan
+from fjsp_msgs.msg import JobState, Place, Plan, PlanTask, RobotPlan
 from fjsp_planner.execution.tracking import MissionTracker
 from fjsp_planner.model.problem import Problem
 from fjsp_planner.model.schedule import Result, Schedule
@@ -56,7 +56,15 @@ def plan_msg(scenario: Problem, posed: Problem, schedule: Schedule, result: Resu
                 scenario_id=scenario.name, reasons=list(reasons),
                 mission_start=mission_start, time_scale=time_scale,
                 makespan=float(result.makespan), solver_status=str(result.status),
-                lower_bound=_float(result.lower_bound), robots=robots)
+                lower_bound=_float(result.lower_bound), robots=robots,
+                places=places(scenario))
+
+
+def places(scenario: Problem) -> list[Place]:
+    """The scenario's map: every location it gives coordinates (2-D ones at z = 0)."""
+    return [Place(name=name, x=float(point[0]), y=float(point[1]),
+                  z=float(point[2]) if len(point) > 2 else 0.0)
+            for name, point in scenario.coordinates.items()]
 
 
 def _predecessors(scenario: Problem, posed: Problem, job: str) -> list[str]:
@@ -73,7 +81,8 @@ def cancel_msg(scenario: Problem, mission_id: str, revision: int, mission_start,
                 scenario_id=scenario.name, mission_start=mission_start, time_scale=time_scale,
                 cancelled=True, makespan=math.nan, solver_status='cancelled',
                 lower_bound=math.nan, reasons=list(reasons),
-                robots=[RobotPlan(robot=r.name, robot_type=r.type) for r in scenario.robots])
+                robots=[RobotPlan(robot=r.name, robot_type=r.type) for r in scenario.robots],
+                places=places(scenario))
 
 
 def job_states(tracker: MissionTracker) -> list[JobState]:

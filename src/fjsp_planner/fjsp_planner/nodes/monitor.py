@@ -5,7 +5,9 @@ three ways: in its log, a line per event (faults, re-plans with their reasons, a
 voided jobs, robots offline and back) and a frame of the mission whenever something changed;
 on a live web page (`web_port`); and, once a mission ended, as a summary and a Gantt chart of
 the whole mission in `out_dir`. It also publishes each robot's health on `/diagnostics` as
-the fleet sees it, which is how a robot whose agent died shows up there.
+the fleet sees it, which is how a robot whose agent died shows up there, and, when the
+scenario places its locations on a map, each robot's pose on it (`robot_poses`, `fleet_map`)
+for Foxglove's 3D panel and other tools.
 
 Everything it reads is latched (plan, robot states, status) or kept for late joiners (task
 and mission events), so it can be started at any time, even after a mission ended.
@@ -16,13 +18,16 @@ import time
 from pathlib import Path
 
 from rclpy.node import Node
+from std_msgs.msg import Header
 
 from fjsp_common.auth import NodeAuth
 from fjsp_common.contract import (
     DIAGNOSTICS,
+    FLEET_MAP,
     MISSION_EVENTS,
     MISSION_STATUS,
     PLAN,
+    ROBOT_POSES,
     ROBOT_STATES,
     TASK_EVENTS,
     publisher,
@@ -40,7 +45,8 @@ from fjsp_common.parameters import ParameterSpec, table
 from fjsp_common.running import declare, run_node, shorten
 from fjsp_common.vocabulary import RobotMode
 from fjsp_msgs.msg import MissionEvent, MissionStatus, RobotState, TaskEvent
-from fjsp_planner.observe import text, views
+from fjsp_planner.nodes.map_markers import marker_array, pose_array
+from fjsp_planner.observe import fleet_map, text, views
 from fjsp_planner.observe.dashboard import Dashboard
 from fjsp_planner.observe.facts import Decoder, UnreadableMessageError
 from fjsp_planner.observe.history import FleetHistory, MissionHistory, Outcome
@@ -73,6 +79,9 @@ PARAMETERS = table(
                   'seconds between per-robot diagnostics on /diagnostics', low=0.1, high=60.0),
     ParameterSpec('late_threshold', LATE_THRESHOLD, "schedule units a robot's operation may run "
                   'past its plan before its diagnostic is WARN', low=0.0, high=1e6),
+    ParameterSpec('map_frame', 'map', 'frame of the robot poses and map markers'),
+    ParameterSpec('pose_period', 0.1, 'seconds between checks for robots that moved on the '
+                  'map, to publish their poses', low=0.02, high=60.0),
 )
 """The monitor's parameters, in the order it declares them."""
 
@@ -87,8 +96,8 @@ def senders_of(msg) -> set[str]:
 
 
 class MonitorNode(Node):
-    def __init__(self):
-        super().__init__(MONITOR_NODE)
+    def __init__(self, context=None, parameter_overrides=None):
+        super().__init__(MONITOR_NODE, context=context, parameter_overrides=parameter_overrides)
         value = {name: declare(self, spec) for name, spec in PARAMETERS.items()}
         out_dir = value['out_dir']
         self.out_dir = Path(out_dir).expanduser() if out_dir else default_out_dir()
@@ -107,6 +116,8 @@ class MonitorNode(Node):
         self.finished = False
         self.pushed_version = (-1, 0.0)
         self.pushed_timeline = (None, -1, 0.0)
+        self.map_frame = value['map_frame']
+        self.published_map = None
 
         self.dashboard = None
         if web_port:
@@ -122,8 +133,11 @@ class MonitorNode(Node):
         for topic in (PLAN, ROBOT_STATES, TASK_EVENTS, MISSION_EVENTS, MISSION_STATUS):
             subscription(self, topic, self.receiver(topic.type.__name__, topic.name))
         self.diagnostics_pub = publisher(self, DIAGNOSTICS)
+        self.poses_pub = publisher(self, ROBOT_POSES)
+        self.map_pub = publisher(self, FLEET_MAP)
         self.create_timer(value['refresh_period'], self.refresh)
         self.create_timer(value['diagnostics_period'], self.publish_diagnostics)
+        self.create_timer(value['pose_period'], self.publish_map)
         if self.dashboard is not None:
             self.create_timer(value['web_period'], self.push_page)
 
@@ -207,6 +221,7 @@ class MonitorNode(Node):
             header['planner'] = views.planner_state(self.fleet)
             parts['mission'] = header
             parts['story'] = views.story(self.fleet, current, wall)
+            parts['map'] = fleet_map.view(self.fleet, current, wall)
             # The timeline is the largest part: rebuilt when the mission's facts changed, else
             # only as often as its clock needs.
             mission_id, version, at = self.pushed_timeline
@@ -215,6 +230,26 @@ class MonitorNode(Node):
                 self.pushed_timeline = (current.mission_id, current.version, wall)
                 parts['timeline'] = views.timeline(self.fleet, current, wall)
         self.dashboard.publish(parts)
+
+    # --- the map ---------------------------------------------------------------------
+
+    def publish_map(self) -> None:
+        """The robots' poses and the map's markers, whenever a robot moved or changed mode;
+        once empty when the current mission has no map but an earlier one had, so that no
+        viewer keeps showing that one's robots."""
+        current = self.fleet.current()
+        if current is None:
+            return
+        places = fleet_map.places(current)
+        robots = fleet_map.robots_on_map(self.fleet, current, time.time()) if places else []
+        key = (current.mission_id, tuple(places.values()), tuple(robots)) if places else None
+        if key == self.published_map:
+            return
+        self.published_map = key
+        header = Header(stamp=self.get_clock().now().to_msg(), frame_id=self.map_frame)
+        self.poses_pub.publish(pose_array(header, robots))
+        self.map_pub.publish(marker_array(header, list(places.values()), robots,
+                                          fleet_map.size(places)))
 
     # --- diagnostics -----------------------------------------------------------------
 

@@ -2,9 +2,11 @@
 package, nothing fetched from elsewhere, since fleet machines often have no internet) and a
 stream of updates to every open page as server-sent events.
 
-The monitor publishes the page's data as named parts (`mission`, `robots`, `timeline`,
-`story`, `missions`); each page receives every part when it connects, then only the parts
-that changed, each as soon as it changed. Server-sent events are plain HTTP, reconnect by
+The monitor publishes the page's data as named parts (`mission`, `robots`, `map`,
+`timeline`, `story`, `missions`). The page itself comes with the mission written in and every
+part embedded (`page`), so it shows the mission on first load, without JavaScript too; its
+script then receives every part when it connects to the stream, and after that only the
+parts that changed, each as soon as it changed. Server-sent events are plain HTTP, reconnect by
 themselves, and need no library on either side. The server runs on its own threads; the
 monitor's executor only calls `publish`.
 """
@@ -16,10 +18,12 @@ from http import HTTPStatus
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
 
+from fjsp_planner.observe.page import render
+
 WEB = Path(__file__).resolve().parent / 'web'
-FILES = {'/': ('index.html', 'text/html; charset=utf-8'),
-         '/index.html': ('index.html', 'text/html; charset=utf-8'),
-         '/dashboard.js': ('dashboard.js', 'text/javascript; charset=utf-8'),
+PAGE = WEB / 'index.html'
+PAGE_PATHS = ('/', '/index.html')
+FILES = {'/dashboard.js': ('dashboard.js', 'text/javascript; charset=utf-8'),
          '/dashboard.css': ('dashboard.css', 'text/css; charset=utf-8')}
 KEEPALIVE = 15.0
 """Seconds between comments sent to an idle page, so a closed one is noticed."""
@@ -76,6 +80,12 @@ class Dashboard:
         self._server.server_close()
         self._thread.join(timeout=2.0)
 
+    def page(self) -> str:
+        """The page with the current parts written in."""
+        with self._condition:
+            parts = {name: json.loads(text) for name, text in self._parts.items()}
+        return render(PAGE.read_text(), parts)
+
     def _since(self, version: int) -> tuple[int, str | None]:
         """The current version, and the parts changed after `version` as one JSON object."""
         names = [n for n, v in self._changed_at.items() if v > version]
@@ -103,7 +113,10 @@ class Dashboard:
 
             def do_GET(self):  # noqa: N802  (the name http.server calls)
                 path = self.path.split('?', 1)[0]
-                if path in FILES:
+                if path in PAGE_PATHS:
+                    self._send(HTTPStatus.OK, 'text/html; charset=utf-8',
+                               dashboard.page().encode())
+                elif path in FILES:
                     name, kind = FILES[path]
                     self._send(HTTPStatus.OK, kind, (WEB / name).read_bytes())
                 elif path == '/state':

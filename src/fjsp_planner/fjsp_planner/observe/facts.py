@@ -57,6 +57,16 @@ class PlannedTask:
 
 
 @dataclass(frozen=True)
+class MapPlace:
+    """A location of the mission's map (a 2-D one at z = 0)."""
+
+    name: str
+    x: float
+    y: float
+    z: float
+
+
+@dataclass(frozen=True)
 class PlanFact:
     stamp: float
     """Wall time of publication, seconds since the epoch (as every stamp here)."""
@@ -73,6 +83,8 @@ class PlanFact:
     robots: tuple[tuple[str, str], ...]
     """(robot, robot type) of every robot of the scenario, in the plan's order."""
     tasks: tuple[PlannedTask, ...]
+    places: tuple[MapPlace, ...] = ()
+    """The scenario's map (empty: it has none)."""
 
     @property
     def clock(self) -> ScheduleClock | None:
@@ -222,7 +234,10 @@ class Decoder:
                         cancelled=bool(msg.cancelled), makespan=msg.makespan,
                         solver_status=msg.solver_status, lower_bound=msg.lower_bound,
                         reasons=tuple(msg.reasons),
-                        robots=tuple((r.robot, r.robot_type) for r in msg.robots), tasks=tasks)
+                        robots=tuple((r.robot, r.robot_type) for r in msg.robots), tasks=tasks,
+                        # A recording made before plans carried a map decodes without one.
+                        places=tuple(MapPlace(p.name, p.x, p.y, p.z)
+                                     for p in getattr(msg, 'places', ())))
 
     def task_event(self, msg) -> TaskEventFact:
         return TaskEventFact(stamp=seconds(msg.stamp), event_id=msg.event_id,

@@ -1,5 +1,6 @@
-// The live mission page: keeps the parts the monitor publishes (server-sent events on
-// /events) and redraws the ones that changed. Plain DOM and SVG, no library.
+// The live mission page: draws the parts the server embedded in the page at once, then keeps
+// the parts the monitor publishes (server-sent events on /events) and redraws the ones that
+// changed. Plain DOM and SVG, no library.
 'use strict';
 
 const data = {};
@@ -225,6 +226,64 @@ function renderTimeline() {
   box.replaceChildren(chart);
 }
 
+function renderMap() {
+  const m = data.map;
+  const section = $('map-section');
+  section.hidden = !m;
+  if (!m) return;
+  const box = $('map');
+  // Seen from above, x east and y north; a height is drawn upward from the place's ground
+  // point, with a dashed line down to it.
+  const up = (p) => p.y + (m.three_d ? p.z : 0);
+  $('map-view').textContent = m.three_d ? '(seen from above; heights drawn upward)' : '(seen from above)';
+  const points = [...m.places, ...m.robots.filter((r) => r.x !== undefined)];
+  const xs = points.map((p) => p.x), ys = points.flatMap((p) => [p.y, up(p)]);
+  const [minX, maxX, minY, maxY] = [Math.min(...xs), Math.max(...xs), Math.min(...ys), Math.max(...ys)];
+  const margin = 48, width = Math.max(box.clientWidth || 900, 400);
+  const span = Math.max(maxX - minX, maxY - minY, 1e-9);
+  const scale = Math.min((width - 2 * margin) / Math.max(maxX - minX, span / 4),
+    440 / Math.max(maxY - minY, span / 4));
+  const height = (maxY - minY) * scale + 2 * margin;
+  const left = (width - (maxX - minX) * scale) / 2;
+  const sx = (x) => left + (x - minX) * scale;
+  const sy = (p, z = true) => margin + (maxY - (z ? up(p) : p.y)) * scale;
+  const chart = svg('svg', {width, height, viewBox: `0 0 ${width} ${height}`});
+  const byName = Object.fromEntries(m.places.map((p) => [p.name, p]));
+  for (const p of m.places) {
+    if (m.three_d && p.z !== 0) {
+      chart.appendChild(svg('line', {x1: sx(p.x), x2: sx(p.x), y1: sy(p), y2: sy(p, false),
+        class: 'height'}));
+    }
+    const done = p.done.length ? ` (done: ${p.done.join(', ')})` : '';
+    chart.appendChild(svg('circle', {cx: sx(p.x), cy: sy(p), r: 6, class: 'place',
+      'data-place': p.name}, `${p.name} (${[p.x, p.y, p.z].map((v) => +v.toFixed(3)).join(', ')}): ${p.jobs.join(', ') || 'no job'}${done}`));
+    chart.appendChild(svg('text', {x: sx(p.x), y: sy(p) + 20, class: 'place-name'})).textContent = p.name;
+  }
+  for (const r of m.robots) {
+    const from = byName[r.location], to = byName[r.destination];
+    if (r.x === undefined || !from || !to) continue;
+    chart.appendChild(svg('line', {x1: sx(from.x), y1: sy(from), x2: sx(to.x), y2: sy(to),
+      class: 'leg', 'data-robot': r.robot}));
+  }
+  for (const r of m.robots) {
+    if (r.x === undefined) continue;
+    // Robots at one spot sit round it (east over north to west); each name goes outward.
+    const [dx, dy] = r.spread;
+    const x = sx(r.x) + 16 * dx, y = sy(r) - 16 * dy;
+    const doing = r.job ? ` on ${r.job}` : '';
+    const where = r.destination ? `${r.location || '?'} \u2192 ${r.destination}` : r.location;
+    chart.appendChild(svg('circle', {cx: x, cy: y, r: 8, class: 'robot', 'data-robot': r.robot,
+      'data-mode': r.mode}, `${r.robot}: ${r.mode}${doing} at ${where}`));
+    const alone = dx === 0 && dy === 0;
+    const anchor = alone || dx > 0.3 ? 'start' : dx < -0.3 ? 'end' : 'middle';
+    const label = svg('text', {x: x + (alone ? 10 : 11 * dx), y: alone ? y - 8 : y - 12 * dy + 4,
+      class: 'robot-name', 'text-anchor': anchor});
+    label.textContent = r.robot;
+    chart.appendChild(label);
+  }
+  box.replaceChildren(chart);
+}
+
 function niceStep(end) {
   const raw = end / 10;
   const power = 10 ** Math.floor(Math.log10(raw));
@@ -257,8 +316,8 @@ function renderMissions() {
   }
 }
 
-const RENDER = {mission: renderMission, robots: renderRobots, timeline: renderTimeline,
-  story: renderStory, missions: renderMissions};
+const RENDER = {mission: renderMission, robots: renderRobots, map: renderMap,
+  timeline: renderTimeline, story: renderStory, missions: renderMissions};
 
 function apply(update) {
   Object.assign(data, update);
@@ -274,5 +333,7 @@ function connect() {
   source.addEventListener('update', (event) => apply(JSON.parse(event.data)));
 }
 
-window.addEventListener('resize', renderTimeline);
+window.addEventListener('resize', () => { renderTimeline(); renderMap(); });
+// What the server wrote into the page, drawn before the first update arrives.
+apply(JSON.parse($('initial-state').textContent));
 connect();
