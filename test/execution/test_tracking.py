@@ -616,6 +616,27 @@ def test_a_failure_and_recovery_within_one_planner_tick_are_seen(planned):
     assert tracker.failed_since(2) == frozenset() and tracker.failed_since(1) == {'MARC2'}
 
 
+def test_a_robot_on_a_leg_or_stopped_on_one_is_placed_at_the_point_it_reached(planned):
+    """MARC2 (speed 25, MARC locomotion 1) reports 37.5 % of its way from M1 to Ja; the
+    planner places it at 37 % of that leg: at least as far as it got, never further."""
+    problem, schedule = planned
+    tracker = MissionTracker(problem)
+    tracker.set_plan(schedule, 1)
+    leg = problem.travel('MARC2', 'M1', 'Ja')
+    tracker.record_robot_state('MARC2', 'travelling', 'M1', 'Ja', 10.0, 'Ja', progress=0.375)
+    way = tracker.execution_state(5.0).robots['MARC2'].on_way
+    assert (way.origin, way.destination, way.share) == ('M1', 'Ja', Fraction(37, 100))
+    # Stopped there (a new plan no longer needed the leg): free at once, the leg's end the
+    # rest of the leg away.
+    tracker.record_robot_state('MARC2', 'idle', 'M1', 'Ja', math.nan, '', progress=0.375)
+    stopped = tracker.execution_state(6.0).robots['MARC2']
+    assert stopped.on_way == way
+    assert (stopped.location, stopped.free_at) == ('Ja', 6 + Fraction(63, 100) * leg)
+    # A progress out of [0, 1] says nothing: the robot is taken to drive on to the end.
+    tracker.record_robot_state('MARC2', 'travelling', 'M1', 'Ja', 10.0, 'Ja', progress=1.5)
+    assert tracker.execution_state(6.0).robots['MARC2'].on_way is None
+
+
 def test_a_restarted_agent_that_reports_no_place_is_where_it_was(planned):
     """Found by the soak: the Assembler's agent was killed in panel 1 and started again; its
     new process reported no location, the re-plan placed it anywhere, sent it to a job of

@@ -277,7 +277,8 @@ class MissionController:
         before = mission.tracker.robots[report.robot].mode
         mission.tracker.record_robot_state(report.robot, report.mode, report.location,
                                            report.destination, report.busy_until,
-                                           report.current_job, at=self._units(mission, wall))
+                                           report.current_job, at=self._units(mission, wall),
+                                           progress=report.progress)
         if report.mode == RobotMode.FAILED and before != RobotMode.FAILED:
             effects.append(Note(MissionEventKind.ROBOT_FAILED, robot=report.robot))
         elif before == RobotMode.FAILED and report.mode != RobotMode.FAILED:
