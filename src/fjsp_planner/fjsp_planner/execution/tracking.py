@@ -606,19 +606,25 @@ class MissionTracker:
     def _as_executed(self, executed: Schedule) -> Problem:
         """The problem restricted to the executed jobs, operations free of duration and
         distances relaxed to shortest routes where the direct one does not fit."""
-        p = self.problem
+        p = without_durations(self.problem)
         done = set(executed.jobs)
-        locomote = p.locomote
         return dataclasses.replace(
             p, jobs=tuple(j for j in p.jobs if j.name in done),
             precedence=tuple((a, b) for a, b in p.precedence if a in done and b in done),
             holding=tuple((a, b, q) for a, b, q in p.holding if a in done and b in done),
-            robot_types={name: {q: (t if q == locomote else Fraction(0))
-                                for q, t in times.items()}
-                         for name, times in p.robot_types.items()},
-            time_overrides=dict.fromkeys(p.time_overrides, Fraction(0)),
             distances=relaxed_distances(p, executed), fixed={}, panels=(),
             name=f'{p.name} as executed')
+
+
+def without_durations(problem: Problem) -> Problem:
+    """`problem` with every operation free of duration: how a timeline whose operations
+    lasted as long as the robots took is judged. Each robot's operations are overridden with
+    0 (those of the locomote type too, as the paper's moves are), while travel, which reads
+    the robot type's efficiency, keeps its time."""
+    return dataclasses.replace(problem, time_overrides={
+        **dict.fromkeys(problem.time_overrides, Fraction(0)),
+        **{(r.name, q): Fraction(0) for r in problem.robots
+           for q in problem.robot_types.get(r.type, {})}})
 
 
 def relaxed_distances(problem: Problem, executed: Schedule) -> dict:
