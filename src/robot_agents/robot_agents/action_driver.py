@@ -16,6 +16,7 @@ request only after sending it, so an answer taken by another thread in between i
 import math
 import re
 from collections.abc import Callable
+from dataclasses import dataclass
 
 from action_msgs.msg import GoalStatus
 from rclpy.action import ActionClient
@@ -50,26 +51,26 @@ def usable(node: Node, name: str) -> bool:
         return False
 
 
+@dataclass
 class _Goal:
     """One leg or operation sent to a server, from sending to its end."""
 
-    def __init__(self, kind, name: str, message, start: float, nominal: float):
-        self.kind = kind
-        self.name = name
-        self.message = message
-        self.start = start
-        """Schedule time it began (the plan's instant, see `drivers`)."""
-        self.nominal = nominal
-        """Wall seconds the plan gives it."""
-        self.sent = False
-        self.waiting_since = math.nan
-        """Wall seconds since which it waits for its server."""
-        self.handle = None
-        self.share = 0.0
-        self.expected = nominal
-        """Wall seconds the server expects it to take, from its latest feedback."""
-        self.ending: Ending | None = None
-        self.cancelled = False
+    kind: type
+    name: str
+    message: object
+    start: float
+    """Schedule time it began (the plan's instant, see `drivers`)."""
+    nominal: float
+    """Wall seconds the plan gives it."""
+    sent: bool = False
+    waiting_since: float = math.nan
+    """Wall seconds since which it waits for its server."""
+    handle: object = None
+    share: float = 0.0
+    expected: float = 0.0
+    """Wall seconds the server expects it to take, from its latest feedback (0: none yet)."""
+    ending: Ending | None = None
+    cancelled: bool = False
 
 
 class ActionDriver:
