@@ -141,7 +141,6 @@ class RobotExecution:
         self._factor = 1.0
         """Duration factor of the next operation the robot begins (delay faults)."""
         self._work_factor = 1.0
-        self._failed_at = math.nan
         self._driver_failures: list[str] = []
         self._job_robots: dict[str, frozenset[str]] = {}
         self._arrived: dict[tuple[str, str], _Fact] = {}
@@ -379,7 +378,7 @@ class RobotExecution:
         else:
             self.destination = ''
             message += f" at '{self.location}'" if self.location else ''
-        self._phase, self._failed_at, self._holding = _Phase.FAILED, now, ''
+        self._phase, self._holding = _Phase.FAILED, ''
         self._begun = False
         return message
 
@@ -479,7 +478,7 @@ class RobotExecution:
         self.__init__(self.robot, self.driver)
         self.location = here
         if failed:
-            self._phase, self._failed_at = _Phase.FAILED, 0.0
+            self._phase = _Phase.FAILED
 
     # --- stepping --------------------------------------------------------------------
 
