@@ -44,7 +44,9 @@ must not make robots look lost, which this bench does not measure."""
 class Scenario:
     name: str
     path: Path
-    panels: int = 0
+    panels: int
+    time_limit: float
+    """Seconds for each mission's first plan."""
 
 
 @dataclass(frozen=True)
@@ -95,7 +97,8 @@ def run_missions(scenario: Scenario, noise: float, args, out: Path) -> list[Miss
         with MissionClient(domain_id=fleet.domain) as client:
             for _ in range(args.missions):
                 result = client.run(scenario.path, panels=scenario.panels,
-                                    time_scale=args.time_scale, time_limit=args.time_limit,
+                                    time_scale=args.time_scale,
+                                    time_limit=scenario.time_limit,
                                     timeout=args.timeout)
                 # A plan a robot did not take is published again: one per revision.
                 plans = list({p.revision: p for p in list(fleet.observer.plans)
@@ -140,9 +143,8 @@ def main(argv) -> int:
     parser.add_argument('--noise', type=float, nargs='+', default=[0.0, 0.1, 0.3],
                         help='spread of the simulated durations (0.3: +-30 %%)')
     parser.add_argument('--missions', type=int, default=20)
-    parser.add_argument('--time-scale', type=float, default=0.1,
+    parser.add_argument('--time-scale', type=float, default=0.05,
                         help='wall seconds per schedule unit')
-    parser.add_argument('--time-limit', type=float, default=20.0, help='first plan, seconds')
     parser.add_argument('--replan-time-limit', type=float, default=1.0)
     parser.add_argument('--delay-threshold', type=float, default=2.0,
                         help="the planner's: units an operation may run late before a re-plan")
@@ -154,9 +156,9 @@ def main(argv) -> int:
     args = parser.parse_args(argv)
     with tempfile.TemporaryDirectory(prefix='fjsp-bench-noise-') as out:
         out = Path(out)
-        scenarios = {'panel': Scenario('1 panel', PAPER, 1),
-                     'panels2': Scenario('2 panels', PAPER, 2),
-                     'generated60': Scenario('60 jobs', generated(out))}
+        scenarios = {'panel': Scenario('1 panel', PAPER, 1, 5.0),
+                     'panels2': Scenario('2 panels', PAPER, 2, 10.0),
+                     'generated60': Scenario('60 jobs', generated(out), 0, 20.0)}
         print(f'{args.missions} missions per row, {args.time_scale:g} s per unit, re-plan '
               f'limit {args.replan_time_limit:g} s, delay threshold {args.delay_threshold:g}, '
               f'drift threshold {args.drift_threshold:g}')
