@@ -14,7 +14,8 @@ setup(
     zip_safe=True,
     maintainer='fjsp team',
     maintainer_email='team@fjsp.invalid',
-    description='Generic mock robot agent executing planned task sequences (+ per-type aliases)',
+    description='Generic robot agent executing planned task sequences through a driver '
+                '(+ per-type aliases), and a simulated robot serving its actions',
     license='Apache-2.0',
     entry_points={
         'console_scripts': [
@@ -22,6 +23,7 @@ setup(
             'assembler_agent = robot_agents.agent_node:assembler_main',
             'marc_agent = robot_agents.agent_node:marc_main',
             'lsms_agent = robot_agents.agent_node:lsms_main',
+            'sim_robot = robot_agents.sim_robot:main',
         ],
     },
 )

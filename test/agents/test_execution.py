@@ -5,7 +5,8 @@ import math
 import pytest
 
 from fjsp_common.vocabulary import EventKind, RobotMode
-from robot_agents.execution import RobotExecution, Task, later
+from robot_agents.drivers import later
+from robot_agents.execution import RobotExecution, Task
 
 ARRIVED, STARTED, DONE, ABORTED = (EventKind.ARRIVED, EventKind.STARTED,
                                    EventKind.OPERATION_DONE, EventKind.ABORTED)
@@ -188,7 +189,7 @@ def test_fail_while_working_aborts_and_stops_until_recovered_and_replanned():
                                  (DONE, 'J2', 12)]
 
 
-def test_fail_mid_leg_freezes_it_and_recovery_ends_the_leg():
+def test_fail_mid_leg_stops_it_there_and_it_recovers_there():
     r = RobotExecution('A')
     plan(r, 1, [task('J0', 0, 1), task('J1', 5, 1, leg=4)])
     r.step(3)                              # left J0 at 1, due at J1 at 5
@@ -200,17 +201,29 @@ def test_fail_mid_leg_freezes_it_and_recovery_ends_the_leg():
     assert r.progress(9) == pytest.approx(0.5)
     assert r.step(100) == []
 
-    r.recover(10)                          # 2 units of the leg are left
+    result = r.recover(10)
+    assert "on its way from 'J0' to 'J1' (50% done)" in result.message
+    assert r.step(100) == []               # it waits where it stopped for a new plan
     assert (r.mode, r.current_job, r.location, r.destination) == (
-        RobotMode.TRAVELLING, '', 'J0', 'J1')
-    assert r.busy_until == pytest.approx(12) and r.progress(11) == pytest.approx(0.75)
-    assert r.step(11.9) == []
-    assert r.step(12.1) == []              # a leg of no task reports no arrival
-    assert (r.mode, r.location, r.destination) == (RobotMode.IDLE, 'J1', '')
-    plan(r, 2, [task('J1', 13, 1)], now=12.5)
+        RobotMode.IDLE, '', 'J0', 'J1')
+    assert r.progress(100) == pytest.approx(0.5) and math.isnan(r.busy_until)
+    # The planner sends it on to J1 from there: the 2 units of the leg that are left.
+    plan(r, 2, [task('J1', 102, 1, leg=2)], now=100)
+    assert r.step(101.9) == [] and r.busy_until == pytest.approx(102)
     # Its first attempt at J1 began with the leg, so this arrival is its second.
-    assert attempts(r.step(12.5)) == [(ARRIVED, 'J1', 2), (STARTED, 'J1', 2)]
-    assert r.busy_until == pytest.approx(13.5)
+    assert attempts(r.step(102.1)) == [(ARRIVED, 'J1', 2), (STARTED, 'J1', 2)]
+
+
+def test_a_plan_placing_a_stopped_robot_nearer_than_it_is_does_not_make_it_arrive_sooner():
+    """A plan made before the planner heard where the robot stopped may give it a shorter
+    leg than what is left of the one it stopped on: it takes what is left."""
+    r = RobotExecution('A')
+    plan(r, 1, [task('J0', 0, 1), task('J1', 5, 1, leg=4)])
+    r.fail(2)                              # a quarter of the way: 3 units left to J1
+    r.recover(2)
+    plan(r, 2, [task('J1', 3, 1, leg=1)], now=2)
+    assert r.step(4.9) == [] and r.busy_until == pytest.approx(5)
+    assert kinds(r.step(5.1)) == [(ARRIVED, 'J1', 5), (STARTED, 'J1', 5)]
 
 
 def test_fail_while_holding_releases_the_hold():
@@ -435,15 +448,30 @@ def test_a_predecessor_done_before_the_revision_and_never_heard_of_does_not_hold
     assert kinds(r.step(3)) == [(ARRIVED, 'J2', 3), (STARTED, 'J2', 3)]
 
 
-def test_robot_finishes_its_leg_before_following_the_new_sequence():
+def test_a_leg_no_task_needs_is_stopped_where_the_robot_is():
+    """Found in a mission: a recovered crane, sent elsewhere by the new plan, first drove
+    to the end of a 183-unit leg no task needed any more. It stops, and leaves from there
+    with the leg the plan gives it, which the planner reckoned from that point."""
     r = RobotExecution('A')
     plan(r, 1, [task('J1', 0, 1), task('J2', 5, 1, leg=4)])
-    r.step(2)                              # on its way to J2, due at 5
-    plan(r, 2, [task('J3', 8, 1, leg=3)], now=2)
+    r.step(2)                              # on its way to J2 since 1, a quarter done
+    plan(r, 2, [task('J3', 5, 1, leg=3)], now=2)
     assert (r.mode, r.current_job, r.location, r.destination) == (
-        RobotMode.TRAVELLING, '', 'J1', 'J2')
+        RobotMode.IDLE, '', 'J1', 'J2')
+    assert r.progress(2) == pytest.approx(0.25, abs=1e-6)
+    assert r.step(2) == []
+    assert (r.mode, r.location, r.destination) == (RobotMode.TRAVELLING, 'J1', 'J3')
     assert r.busy_until == pytest.approx(5)
-    assert kinds(r.step(10)) == [(ARRIVED, 'J3', 8), (STARTED, 'J3', 8), (DONE, 'J3', 9)]
+    assert kinds(r.step(10)) == [(ARRIVED, 'J3', 5), (STARTED, 'J3', 5), (DONE, 'J3', 6)]
+
+
+def test_a_leg_not_begun_when_the_plan_changes_is_not_travelled():
+    r = RobotExecution('A')
+    plan(r, 1, [task('J1', 5, 1, leg=2)])  # released at 3, 2 units from J1
+    r.set_plan(2, [task('J2', 4, 1, leg=1, location='J2')], {'J2': {'A'}}, 1.0,
+               restarted_in={'J2': 2})
+    assert (r.mode, r.destination) == (RobotMode.IDLE, '')
+    assert kinds(r.step(5)) == [(ARRIVED, 'J2', 4), (STARTED, 'J2', 4)]
 
 
 def test_own_operation_done_and_continued_keeps_waiting_for_the_job_end():

@@ -24,6 +24,7 @@ from fjsp_planner.execution.replan import (
     ExecutionState,
     RobotSituation,
     StateError,
+    Waypoint,
     frozen,
     improve,
     repair,
@@ -364,6 +365,56 @@ def test_holders_carrying_a_part_are_replanned_from_where_they_are(now):
     result = check_replan(problem, plan, at(problem, now, {'C'}, plan), time_limit=5.0)
     assert result.schedule.jobs['Place'].start == 7
     assert result.result.makespan == 9
+
+
+def crossroads() -> Problem:
+    """Places a, b, c: b is 10 from a and from c, c is 2 from a. R (speed 1, travel =
+    distance) starts at a; X is at b, Y at c, each takes 1."""
+    distances = {('a', 'b'): 10, ('a', 'c'): 2, ('b', 'c'): 10}
+    return Problem(
+        operation_types={0: 'grip', 1: 'locomote'},
+        robot_types={'Rover': {0: Fraction(1), 1: Fraction(1)}},
+        robots=(Robot('R', 'Rover', start_location='a'),),
+        jobs=(Job('X', 'b', ((0,),)), Job('Y', 'c', ((0,),))),
+        distances={**{k: Fraction(v) for k, v in distances.items()},
+                   **{(b, a): Fraction(v) for (a, b), v in distances.items()}},
+        locomote=1, name='crossroads')
+
+
+def test_a_robot_on_a_leg_is_replanned_from_the_point_it_reached():
+    """R left a at 0 for X at b (arrival 10) and is a fifth of the way at 2. From there, c
+    is 4 away (back through a: 2 + 2; on through b: 8 + 10), b is 8: Y at c [6, 7], then X
+    at b [17, 18], makespan 18. Planned from b, where the leg ends, it would be X [10, 11],
+    Y [21, 22]: 22."""
+    problem = crossroads()
+    way = Waypoint('a', 'b', Fraction(1, 5))
+    state = ExecutionState(Fraction(2), frozenset(), {}, {
+        'R': RobotSituation('R', True, 'b', Fraction(10), on_way=way)})
+    result = check_replan_result(state, replan(problem, PLAN_XY, state, time_limit=5.0))
+    posed = result.residual.problem
+    assert (posed.robot('R').start_location, posed.robot('R').release_time) == ('a->b@0.20', 2)
+    assert (posed.distance('a->b@0.20', 'c'), posed.distance('a->b@0.20', 'b')) == (4, 8)
+    assert result.schedule.sequences['R'] == ('Y', 'X')
+    assert result.result.makespan == 18
+    # Without the point reached, the same state is planned from the end of the leg.
+    at_b = ExecutionState(Fraction(2), frozenset(), {}, {
+        'R': RobotSituation('R', True, 'b', Fraction(10))})
+    assert replan(problem, PLAN_XY, at_b, time_limit=5.0).result.makespan == 22
+
+
+PLAN_XY = Schedule(jobs={'X': assign('X', 10, 11, {'R': 0}), 'Y': assign('Y', 21, 22, {'R': 0})},
+                   sequences={'R': ('X', 'Y')})
+
+
+def test_a_slow_leg_releases_the_robot_no_earlier_than_its_reported_arrival_allows():
+    """R reports arriving at b at 14, not 10: from its point a fifth of the way, 8 from b,
+    it is free to turn at 6, not at 2."""
+    problem = crossroads()
+    state = ExecutionState(Fraction(2), frozenset(), {}, {
+        'R': RobotSituation('R', True, 'b', Fraction(14),
+                            on_way=Waypoint('a', 'b', Fraction(1, 5)))})
+    posed = residual_problem(problem, state, PLAN_XY).problem
+    assert posed.robot('R').release_time == 6
 
 
 @pytest.fixture(scope='module')

@@ -5,8 +5,10 @@ The missions run at 0.1 s per schedule unit (the paper's 32 units take about 3 s
 can land mid-mission and a re-plan takes a few units of schedule time.
 """
 
+from fractions import Fraction
 
 from fjsp_msgs.msg import MissionStatus, TaskEvent
+from fjsp_planner.execution.replan import Waypoint
 from fjsp_planner.testing import valid_events
 
 from repo_paths import PAPER
@@ -43,7 +45,8 @@ def check_completed_mission(fleet, out=()):
 
 def check_starts_where_robots_are(problem, observer, revision):
     """Each robot's first new task of `revision` departs from a place the robot reported
-    being at (or heading to) after the previous revision was published."""
+    being at (or heading to) after the previous revision was published, or from the point
+    it reached of a leg it reported (the plan's start location names that waypoint)."""
     plans = {p.revision: p for p in observer.plans}
     previous = plans[revision - 1].stamp
     checked = []
@@ -51,13 +54,20 @@ def check_starts_where_robots_are(problem, observer, revision):
         tasks = robot_plan.tasks
         if not tasks or any(t.continued for t in tasks):
             continue
-        first = tasks[0]
-        reported = set()
+        first, robot = tasks[0], problem.robot(robot_plan.robot)
+        reported, ways = set(), set()
         for s in observer.robot_history:
             if s.robot == robot_plan.robot and _after(s.stamp, previous):
                 reported |= {s.location, s.destination} - {''}
-        legs = {float(problem.travel(robot_plan.robot, place, first.location))
-                for place in reported}
+                ways.add((s.location, s.destination))
+        legs = {float(problem.travel(robot.name, place, first.location)) for place in reported}
+        per_distance = problem.robot_types[robot.type][problem.locomote] / robot.speed
+        for origin, destination in ways:
+            prefix = f'{origin}->{destination}@'
+            if robot_plan.start_location.startswith(prefix):
+                way = Waypoint(origin, destination,
+                               Fraction(robot_plan.start_location[len(prefix):]))
+                legs.add(float(way.distance(problem, first.location) * per_distance))
         assert any(abs(first.arrival - first.travel_start - leg) < 1e-6 for leg in legs), (
             robot_plan.robot, first.job, first.arrival - first.travel_start, reported)
         checked.append(robot_plan.robot)

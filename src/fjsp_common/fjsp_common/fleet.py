@@ -19,6 +19,11 @@ def agent_node_name(robot: str) -> str:
     return f'agent_{robot}'
 
 
+def sim_robot_node_name(robot: str) -> str:
+    """The node of a simulated robot (`sim_robot`), serving the robot's actions to its agent."""
+    return f'sim_{robot}'
+
+
 HEARTBEAT_PERIOD = 0.2
 """Seconds between the robot states an agent publishes as its heartbeat."""
 

@@ -50,7 +50,7 @@ from fjsp_common.contract import (
 from fjsp_common.fleet import PLANNER_NODE, agent_node_name
 from fjsp_common.revisions import Restarts, plan_attempts
 from fjsp_msgs.msg import JobStates, MissionEvent, MissionStatus, Plan, RobotState, TaskEvent
-from fjsp_planner.execution.tracking import relaxed_distances
+from fjsp_planner.execution.tracking import relaxed_distances, without_durations
 from fjsp_planner.faults import inject_fault
 from fjsp_planner.launcher.hosts import HostsUnavailableError, Network
 from fjsp_planner.launcher.listener import Listener, environment
@@ -311,11 +311,15 @@ class FleetHarness(Fleet):
         return subprocess.run([str(find_executable(package, executable)), *args],
                               env=self.env, capture_output=True, text=True, timeout=timeout)
 
-    def check_mission_complete(self, timeout: float = 60.0) -> Schedule:
+    def check_mission_complete(self, timeout: float = 60.0, durations: bool = True
+                               ) -> Schedule:
         """Wait for the mission to complete, then check what a user relies on: every job of
         the scenario done exactly once, the timeline the robots ran (rebuilt from their
         events) valid, and the status agreeing. The executed timeline. A mission that ends
-        failed or cancelled fails the test at once, naming the state and its reasons."""
+        failed or cancelled fails the test at once, naming the state and its reasons.
+
+        With `durations` false, operations may take any time their robots took (robots
+        behind the action driver that run short of the plan, e.g. noisy simulated ones)."""
         problem = self.problem
         jobs = {j.name for j in problem.jobs}
         self.wait_for(lambda o: o.complete() or o.ended_undone(), timeout,
@@ -345,7 +349,7 @@ class FleetHarness(Fleet):
             status = self.observer.status
         check_jobs_done_once(problem, plans, events)
         check_nothing_redone(events, story)
-        executed = check_executed_timeline(problem, plans, events)
+        executed = check_executed_timeline(problem, plans, events, durations)
         assert (status.jobs_done, status.jobs_total, status.jobs_running) == \
             (len(jobs), len(jobs), 0), status
         return executed
@@ -513,14 +517,17 @@ def check_nothing_redone(events, mission_events) -> None:
         raise AssertionError('work done again: ' + '; '.join(redone))
 
 
-def check_executed_timeline(problem: Problem, plans, events) -> Schedule:
-    """The executed timeline, which must cover every job and pass the validator;
-    AssertionError listing what is wrong otherwise."""
+def check_executed_timeline(problem: Problem, plans, events, durations: bool = True
+                            ) -> Schedule:
+    """The executed timeline, which must cover every job and pass the validator (with
+    `durations` false: operations free of duration); AssertionError listing what is wrong
+    otherwise."""
     executed = executed_timeline(problem, plans, events)
     missing = sorted({j.name for j in problem.jobs} - set(executed.jobs))
     if missing:
         raise AssertionError(f'no complete execution reported for {", ".join(missing)}')
-    problems = validate_executed(problem, executed)
+    problems = validate_executed(problem if durations else without_durations(problem),
+                                 executed)
     if problems:
         raise AssertionError('the executed timeline is invalid:\n' + '\n'.join(problems))
     return executed

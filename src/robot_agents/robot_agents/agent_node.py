@@ -1,4 +1,6 @@
-"""A mock robot of any type: follows its task sequence of the latest plan in simulated time.
+"""A robot agent of any type: follows its task sequence of the latest plan, its robot's legs and
+operations done by a driver (`drivers`): timed by the plan (`mock`, the default) or by the
+robot's own action servers (`action`, see `action_driver` and docs/robot-drivers.md).
 
 One process per robot (`robot_name` parameter); its node is named `agent_<robot>`, so a fleet
 never has two nodes of the same name. Its type comes from the plan, unless the `robot_type`
@@ -53,6 +55,16 @@ from fjsp_common.running import ParameterError, declare, run_node, shorten
 from fjsp_common.vocabulary import EventKind, RobotMode
 from fjsp_msgs.msg import Plan, RobotState, TaskEvent
 from fjsp_msgs.srv import InjectFault
+from robot_agents.action_driver import (
+    DEFAULT_OPERATION_ACTION,
+    DEFAULT_TRAVEL_ACTION,
+    OPERATION_FIELD,
+    ROBOT_FIELD,
+    ActionDriver,
+    action_name,
+    usable,
+)
+from robot_agents.drivers import MockDriver
 from robot_agents.execution import FaultResult, RobotExecution, Task
 from robot_agents.reports import ReportLog
 
@@ -80,6 +92,18 @@ PARAMETERS = table(
     ParameterSpec('reports_dir', '', 'directory where the agent keeps its reports, so that a '
                   'planner resuming a mission learns what this robot did before its agent '
                   'restarted; empty: not kept'),
+    ParameterSpec('driver', 'mock', "who moves the robot: 'mock' takes the plan's times, "
+                  "'action' sends each leg and operation to the robot's action servers",
+                  choices=('mock', 'action')),
+    ParameterSpec('travel_action', DEFAULT_TRAVEL_ACTION, 'the Travel action server of the '
+                  f'robot (action driver); {ROBOT_FIELD} is replaced by the robot name'),
+    ParameterSpec('operation_action', DEFAULT_OPERATION_ACTION, 'the '
+                  'ExecuteOperation action server of the robot (action driver); '
+                  f'{ROBOT_FIELD} is replaced by the robot name, {OPERATION_FIELD} by the '
+                  "operation type's name"),
+    ParameterSpec('server_timeout', 10.0, 'seconds an action server may take to be there for '
+                  'a goal before the robot counts as failed (action driver)', low=0.1,
+                  high=600.0),
 )
 """The agent's parameters, in the order it declares them; the agent's executable gives
 `robot_name` (read first, to name the node) and `robot_type` (pinned by the per-type aliases)
@@ -108,7 +132,8 @@ class RobotAgent(Node):
         self.last_event_id = ''
         """The latest task event published, for the state: a restarted planner waits for it."""
         self.failures = 0
-        self.execution = RobotExecution(self.robot)
+        self.driver_name = value['driver']
+        self.execution = RobotExecution(self.robot, self.make_driver(value))
         self.mission_id = ''
         self.clock: ScheduleClock | None = None
         """The followed mission's schedule time (None before its first plan)."""
@@ -140,7 +165,20 @@ class RobotAgent(Node):
         self.reports = self.open_reports(reports_dir) if reports_dir else None
         self.publish_state()
         kind = f"a '{self.pinned_type}'" if self.pinned_type else 'any type'
-        self.get_logger().info(f"robot '{self.robot}' ({kind}) ready, waiting for a plan")
+        self.get_logger().info(f"robot '{self.robot}' ({kind}, {self.driver_name} driver) ready, "
+                               'waiting for a plan')
+
+    def make_driver(self, value):
+        if self.driver_name == 'mock':
+            return MockDriver()
+        for name in ('travel_action', 'operation_action'):
+            if not usable(self, action_name(value[name], self.robot, 'operation')):
+                raise ParameterError(f"parameter '{name}' must name an action (letters, "
+                                     f'digits, underscores, slashes; {ROBOT_FIELD}, '
+                                     f'{OPERATION_FIELD}), got {shorten(value[name], 80)!r}')
+        return ActionDriver(self, self.robot, value['travel_action'], value['operation_action'],
+                            value['server_timeout'], lambda: self.clock.time_scale,
+                            lambda: max(self.now_units(), 0.0))
 
     def now_units(self) -> float | None:
         """Schedule time since the mission start, or None before the first plan."""
@@ -193,7 +231,7 @@ class RobotAgent(Node):
                       travel_start=t.travel_start, arrival=t.arrival, start=t.start,
                       operation_end=t.operation_end, end=t.end,
                       co_workers=tuple(t.co_workers), predecessors=tuple(t.predecessors),
-                      held_into_next=t.held_into_next)
+                      held_into_next=t.held_into_next, operation_name=t.operation_name)
                  for t in mine.tasks]
         if mine.incarnation and mine.incarnation != self.incarnation:
             # Planned for an earlier process of this robot, whose work in progress died with
@@ -331,6 +369,12 @@ class RobotAgent(Node):
                 execution.revision, self.refusal, self.mission_id)
 
     def publish_events(self, events) -> None:
+        """Publish what a step of the execution produced, and count the failures its driver
+        reported meanwhile."""
+        for message in self.execution.failures():
+            self.failures += 1
+            self.get_logger().warning(f'robot failure: {message}')
+            self.publish_state()
         for e in events:
             self.event_count += 1
             msg = TaskEvent(
@@ -421,6 +465,8 @@ class RobotAgent(Node):
 
 
     def destroy_node(self):
+        if isinstance(self.execution.driver, ActionDriver):
+            self.execution.driver.close()
         if self.reports is not None:
             try:
                 self.reports.close()

@@ -1,14 +1,22 @@
 """How one robot works through its task sequence, in schedule time, without ROS.
 
-The robot keeps logical time: an operation started at `s` ends at `s + duration`, a leg left
-at `d` arrives at `d + leg`, and a job starts when its last robot arrived and its last
-predecessor completed (for a predecessor done by other robots only, once the planner declared
-it done, so that no robot acts on a completion the planner missed). Everyone derives those
-instants from the same reported facts, so the robots of a job start at the same schedule time
-even though each learns of the last arrival a few milliseconds apart. Wall-clock lateness
-shows up as a robot acting later than its logical time, never as a timeline that breaks the
-schedule's constraints. What the robot learns at `now` (a new plan, a recovery) cannot make
-it act before `now`.
+The physical part (travel, operations, stopping) goes to a driver (`drivers`): the timed
+`MockDriver` by default, or the robot's own actions. The robot keeps logical time: a leg left
+at `d` that the driver says took `t` arrives at `d + t`, an operation started at `s` that took
+`T` ends at `s + T`, and a job starts when its last robot arrived and its last predecessor
+completed (for a predecessor done by other robots only, once the planner declared it done, so
+that no robot acts on a completion the planner missed). Everyone derives those instants from
+the same reported facts, so the robots of a job start at the same schedule time even though
+each learns of the last arrival a few milliseconds apart. Wall-clock lateness shows up as a
+robot acting later than its logical time, never as a timeline that breaks the schedule's
+constraints. What the robot learns at `now` (a new plan, a recovery) cannot make it act before
+`now`.
+
+A leg no task needs any more (a new revision sends the robot elsewhere, or it failed on the
+way) is stopped where the robot is: it then stands between two places, reported as its
+`location` (where the leg began), `destination` and `progress` (the share of the leg behind
+it), and leaves from there with the leg the next plan gives it, which the planner computed
+from that point (docs/robot-drivers.md, "Stopping mid-leg").
 
 Every fact carries the plan revision it was reported under. A revision that restarts a job
 (its task is not `continued`) voids what older revisions reported about it: the job is redone
@@ -23,19 +31,7 @@ from enum import StrEnum
 
 from fjsp_common.revisions import Restarts, void
 from fjsp_common.vocabulary import MAX_DELAY_FACTOR, MIN_DELAY_FACTOR, EventKind, RobotMode
-
-# Reported ends are rounded up onto this grid (schedule units) so that float rounding never
-# makes an operation or a leg look shorter than it is when checked in exact arithmetic.
-GRID = 1e-6
-
-
-def later(t: float) -> float:
-    """The first grid point at least half a grid step after t; t itself where t is not finite
-    or too large for the grid to mean anything. Never raises."""
-    scaled = t / GRID + 0.5
-    if not math.isfinite(scaled):
-        return t
-    return max(t, math.ceil(scaled) * GRID)
+from robot_agents.drivers import Driver, Ending, Leg, MockDriver, Operation
 
 
 def _within_delay_bounds(factor: float) -> bool:
@@ -57,6 +53,7 @@ class Task:
     co_workers: tuple[str, ...] = ()
     predecessors: tuple[str, ...] = ()
     held_into_next: bool = False
+    operation_name: str = ''
 
     @property
     def duration(self) -> float:
@@ -98,7 +95,7 @@ class _Fact:
 class _Phase(StrEnum):
     NEXT = 'next'          # choose the next task
     TRAVEL = 'travel'      # to the current task's location
-    TRANSIT = 'transit'    # ending a leg no task needs any more (new revision, recovery)
+    TRANSIT = 'transit'    # ending a leg whose end is still needed, though not for its task
     WAIT = 'wait'          # at the job, waiting for predecessors and co-workers
     WORK = 'work'
     FINISH = 'finish'      # own operation done, the job's other operations still running
@@ -111,11 +108,14 @@ class RobotExecution:
 
     Feed it plans (`set_plan`), the facts other robots and the planner report (`arrived`,
     `operation_done`, `job_done`, `aborted`) and faults (`fail`, `recover`, `delay`);
-    `step(now)` moves it as far as `now` allows and returns the events it produced.
+    `step(now)` moves it as far as `now` and its driver allow and returns the events it
+    produced. A failure its driver reports (`Ending.failure`) fails the robot as an injected
+    one does; `failures()` hands out the messages of those.
     """
 
-    def __init__(self, robot: str):
+    def __init__(self, robot: str, driver: Driver | None = None):
         self.robot = robot
+        self.driver = driver if driver is not None else MockDriver()
         self.revision = 0
         self.tasks: tuple[Task, ...] = ()
         self.location = ''
@@ -128,14 +128,20 @@ class RobotExecution:
         self._departed = False
         """Whether it has left for its first job of the mission."""
         self._phase_start = math.nan
-        self._phase_end = math.nan
+        """When the leg or operation under way began, or the leg is to begin."""
+        self._leg: Leg | None = None
+        """The leg under way (None: a leg of no length, or none)."""
+        self._begun = False
+        """Whether the driver has the leg or operation under way."""
+        self._stopped: tuple[Leg, float] | None = None
+        """The leg it stopped on (failed, or no longer needed) and the share of it behind it:
+        it stands between `location` and `destination`."""
         self._holding = ''
         """The done jig job whose part the robot holds into its next job ('' if none)."""
         self._factor = 1.0
         """Duration factor of the next operation the robot begins (delay faults)."""
         self._work_factor = 1.0
-        self._failed_at = math.nan
-        self._failed_mid_leg = False
+        self._driver_failures: list[str] = []
         self._job_robots: dict[str, frozenset[str]] = {}
         self._arrived: dict[tuple[str, str], _Fact] = {}
         self._operation_done: dict[tuple[str, str], _Fact] = {}
@@ -175,23 +181,29 @@ class RobotExecution:
     def busy_until(self) -> float:
         """When the current leg or operation ends (NaN when waiting, idle or failed)."""
         if self._phase in (_Phase.TRAVEL, _Phase.TRANSIT, _Phase.WORK):
-            return self._phase_end
+            if self._begun:
+                return self.driver.expected_end()
+            return self._phase_start + (self._leg.duration if self._leg else 0.0)
         return math.nan
 
     def progress(self, now: float) -> float:
-        """0..1 of the current leg or operation; of the leg it stopped on, once failed."""
-        if self._phase == _Phase.FAILED and self._failed_mid_leg:
-            now = self._failed_at
-        elif self._phase not in (_Phase.TRAVEL, _Phase.TRANSIT, _Phase.WORK):
-            return 0.0
-        span = self._phase_end - self._phase_start
-        if span <= 0:
-            return 1.0
-        return min(1.0, max(0.0, (now - self._phase_start) / span))
+        """0..1 of the current leg or operation; of the leg it stopped on, if it stands
+        between two places."""
+        if self._stopped is not None:
+            return self._stopped[1]
+        if self._phase in (_Phase.TRAVEL, _Phase.TRANSIT, _Phase.WORK) and self._begun:
+            return self.driver.progress(now)
+        return 0.0
 
     @property
     def finished(self) -> bool:
         return self._phase == _Phase.DONE and self.revision > 0
+
+    def failures(self) -> list[str]:
+        """What the driver reported as robot failures since the last call, one message each
+        (the robot is FAILED since the first)."""
+        reported, self._driver_failures = self._driver_failures, []
+        return reported
 
     # --- plans -----------------------------------------------------------------------
 
@@ -210,16 +222,18 @@ class RobotExecution:
         theirs are ignored, whichever revisions in between this robot missed (it then redoes
         its part of a job restarted in one of them).
         The robot goes on with its current job only if that job is continued and
-        is the first unfinished task of its new sequence; otherwise it ends the leg it is on
-        (if any) and follows the new sequence from there, abandoning the job it was on without
-        an event (the planner ordered it). A failed robot takes the revision but does nothing.
+        is the first unfinished task of its new sequence. Otherwise it abandons the job it was
+        on without an event (the planner ordered it), stopping an operation under way, and
+        follows the new sequence: on a leg to where its new first task is, it ends the leg;
+        on any other leg it stops where it is, and leaves from there. A failed robot takes
+        the revision but does nothing.
         Raises `ValueError` for a revision that is not newer than the one followed.
         """
         if revision <= self.revision:
             raise ValueError(f'plan revision {revision} is not newer than revision '
                              f'{self.revision} already followed')
         tasks = tuple(tasks)
-        if not self.location and self._phase not in (_Phase.TRAVEL, _Phase.TRANSIT):
+        if not self.location and not self._on_a_leg:
             self.location = start_location
         current = self.task
         previous, self.revision = self.revision, revision
@@ -242,12 +256,33 @@ class RobotExecution:
         if not self._still_holding():
             self._holding = ''
         self._index = 0
-        if self._phase in (_Phase.TRAVEL, _Phase.TRANSIT):
-            # It cannot vanish mid-leg: it ends the leg, then goes on from there.
-            self._phase = _Phase.TRANSIT
+        if self._on_a_leg:
+            first = next((t for t in tasks if not self._finished(t.job)), None)
+            if first is not None and first.location == self.destination:
+                self._phase = _Phase.TRANSIT
+            else:
+                self._stop(now)
+            return
+        if self._phase == _Phase.WORK and self._begun:
+            self.driver.stop(now)
+            self._free_at = now
+        if self._stopped is None:
+            self.destination = ''
+        self._phase = _Phase.NEXT
+
+    @property
+    def _on_a_leg(self) -> bool:
+        """Under way between two places (a leg of no length, or not begun yet, is not)."""
+        return self._phase in (_Phase.TRAVEL, _Phase.TRANSIT) and self._begun
+
+    def _stop(self, now: float) -> None:
+        """Stop the leg under way where the robot is; it is free from `now`."""
+        share = self.driver.stop(now)
+        if share > 0:
+            self._stopped = (self._leg, share)
         else:
             self.destination = ''
-            self._phase = _Phase.NEXT
+        self._begun, self._free_at, self._phase = False, now, _Phase.NEXT
 
     def _continued_index(self, current: Task | None, continued) -> int | None:
         """Where the current job is in the new sequence, if the robot goes on with it."""
@@ -313,53 +348,61 @@ class RobotExecution:
     # --- faults ----------------------------------------------------------------------
 
     def fail(self, now: float) -> FaultResult:
-        """Stop at `now`: abort the operation under way; a leg is frozen where it is."""
+        """Stop at `now`: abort the operation under way; a leg stops where the robot is."""
         if self._phase == _Phase.FAILED:
             return self._refuse('fail', 'has already failed')
         events = self.step(now)
-        message = f"robot '{self.robot}' failed at t={now:.2f}"
+        if self._phase == _Phase.FAILED:        # its driver reported a failure meanwhile
+            return self._refuse('fail', 'has already failed', events)
+        message = self._fail(now, f"robot '{self.robot}' failed", events)
+        return FaultResult(True, f"robot '{self.robot}' failed at t={now:.2f}{message}",
+                           events)
+
+    def _fail(self, now: float, reason: str, events: list[Event]) -> str:
+        """Go FAILED at `now`; what it dropped, for a message."""
+        message = ''
         if self._phase in (_Phase.WORK, _Phase.WAIT):
             # At a job not begun yet, its arrival would let its co-workers start without it.
             job = self.task.job
-            events.append(Event(EventKind.ABORTED, job, now, self._attempts[job],
-                                f"robot '{self.robot}' failed"))
+            events.append(Event(EventKind.ABORTED, job, now, self._attempts[job], reason))
             self.aborted(job, self.revision)
-            message += (f", aborting its operation of job '{job}'" if self._phase == _Phase.WORK
-                        else f", withdrawing from job '{job}' it was waiting for")
-        self._failed_mid_leg = self._phase in (_Phase.TRAVEL, _Phase.TRANSIT)
-        if self._failed_mid_leg:
+            message = (f", aborting its operation of job '{job}'" if self._phase == _Phase.WORK
+                       else f", withdrawing from job '{job}' it was waiting for")
+        if self._on_a_leg:
+            self._stop(now)
+        elif self._phase == _Phase.WORK and self._begun:
+            self.driver.stop(now)
+        if self._stopped is not None:
             message += (f" on its way from '{self.location}' to '{self.destination}' "
-                        f'({self.progress(now):.0%} done)')
+                        f'({self._stopped[1]:.0%} done)')
         else:
             self.destination = ''
             message += f" at '{self.location}'" if self.location else ''
-        self._phase, self._failed_at, self._holding = _Phase.FAILED, now, ''
-        return FaultResult(True, message, events)
+        self._phase, self._holding = _Phase.FAILED, ''
+        self._begun = False
+        return message
 
     def recover(self, now: float) -> FaultResult:
-        """Back in service at `now` where it stopped, its old tasks dropped; a frozen leg
-        resumes to its destination."""
+        """Back in service at `now` where it stopped (on a leg too), its old tasks dropped."""
         if self._phase != _Phase.FAILED:
             return self._refuse('recover', 'has not failed')
         # The planner re-plans on a recovery; until then the robot has nothing to do.
         self.tasks, self._index, self._free_at = (), 0, now
+        self._phase = _Phase.NEXT
         message = f"robot '{self.robot}' recovered at t={now:.2f}"
-        if self._failed_mid_leg:
-            self._phase = _Phase.TRANSIT
-            self._phase_start += now - self._failed_at
-            self._phase_end = later(now + self._phase_end - self._failed_at)
-            message += (f", resuming its leg from '{self.location}' to '{self.destination}' "
-                        f'(arrival at t={self._phase_end:.2f})')
-        else:
-            self._phase = _Phase.NEXT
-            message += f" at '{self.location}'" if self.location else ''
+        if self._stopped is not None:
+            message += (f" on its way from '{self.location}' to '{self.destination}' "
+                        f'({self._stopped[1]:.0%} done)')
+        elif self.location:
+            message += f" at '{self.location}'"
         return FaultResult(True, message)
 
     def delay(self, factor: float, now: float) -> FaultResult:
         """Multiply the duration of the operation under way, or else of the next one.
 
         The factor, and the product of the factors on one operation, must lie within
-        [MIN_DELAY_FACTOR, MAX_DELAY_FACTOR]; beyond, the delay is refused.
+        [MIN_DELAY_FACTOR, MAX_DELAY_FACTOR]; beyond, the delay is refused, as is one of the
+        operation under way when its driver cannot be told (the robot decides).
         """
         if not _within_delay_bounds(factor):       # NaN fails every comparison
             return self._refuse('delay', f'a delay factor must be within '
@@ -368,6 +411,8 @@ class RobotExecution:
         if self._phase == _Phase.FAILED:
             return self._refuse('delay', 'has failed')
         events = self.step(now)
+        if self._phase == _Phase.FAILED:
+            return self._refuse('delay', 'has failed', events)
         working = self._phase == _Phase.WORK
         if not working and not self._work_left():
             return self._refuse('delay', 'has no operation left to do', events)
@@ -378,12 +423,13 @@ class RobotExecution:
                                          f'multiply to within [{MIN_DELAY_FACTOR:g}, '
                                          f'{MAX_DELAY_FACTOR:g}]', events)
         if working:
-            self._work_factor = product
-            end = self._phase_start + self.task.duration * self._work_factor
             # A speed-up cannot end the operation before it was ordered.
-            self._phase_end = later(max(end, now))
+            if not self.driver.retime(self.task.duration * product, now):
+                return self._refuse('delay', 'runs its operation on its own timing: the '
+                                             'operation under way cannot be retimed', events)
+            self._work_factor = product
             return FaultResult(True, f"robot '{self.robot}': operation of job "
-                                     f"'{self.task.job}' now ends at t={self._phase_end:.2f}",
+                                     f"'{self.task.job}' now ends at t={self.busy_until:.2f}",
                                events)
         self._factor = product
         return FaultResult(True, f"robot '{self.robot}': the next operation it begins takes "
@@ -400,32 +446,39 @@ class RobotExecution:
 
     def cancel(self, now: float, reason: str) -> list[Event]:
         """The mission was cancelled at `now`: every task is dropped and a hold released; a
-        job the robot is at (waiting, working or finishing) is reported ABORTED with `reason`.
-        A leg under way is finished first, as a robot cannot vanish mid-leg."""
+        job the robot is at (waiting, working or finishing) is reported ABORTED with `reason`,
+        its operation stopped. A leg under way is finished first, as a robot cannot vanish
+        mid-leg."""
         events = self.step(now)
         task = self.task
         if task is not None and self._phase in (_Phase.WAIT, _Phase.WORK, _Phase.FINISH):
             events.append(Event(EventKind.ABORTED, task.job, now, self._attempts[task.job],
                                 reason))
+        if self._phase == _Phase.WORK and self._begun:
+            self.driver.stop(now)
+            self._begun = False
         self.tasks, self._index, self._holding = (), 0, ''
-        if self._phase in (_Phase.TRAVEL, _Phase.TRANSIT):
+        if self._on_a_leg:
             self._phase = _Phase.TRANSIT
         elif self._phase != _Phase.FAILED:
-            self._phase, self.destination, self._free_at = _Phase.DONE, '', now
+            self._phase, self._free_at = _Phase.DONE, now
+            if self._stopped is None:
+                self.destination = ''
         return events
 
     def start_mission(self) -> None:
-        """Forget the previous mission (its plans, facts and clock), keeping where the robot
-        is and whether it has failed. A leg still under way counts as arrived, and a robot
-        failed mid-leg stays where it stopped: the new mission plans from there."""
+        """Forget the previous mission (its plans, facts and clock), keeping the driver,
+        where the robot is and whether it has failed. A leg still under way, or stopped,
+        counts as arrived, and a robot failed mid-leg stays where the leg began: the new
+        mission plans from there."""
         failed = self._phase == _Phase.FAILED
         here = self.location
-        if self._phase in (_Phase.TRAVEL, _Phase.TRANSIT) and self.destination:
+        if not failed and (self._on_a_leg or self._stopped is not None) and self.destination:
             here = self.destination
-        self.__init__(self.robot)
+        self.__init__(self.robot, self.driver)
         self.location = here
         if failed:
-            self._phase, self._failed_at = _Phase.FAILED, 0.0
+            self._phase = _Phase.FAILED
 
     # --- stepping --------------------------------------------------------------------
 
@@ -439,18 +492,20 @@ class RobotExecution:
     def _advance(self, now: float, events: list[Event]) -> bool:
         if self._phase == _Phase.NEXT:
             return self._next()
-        if self._phase == _Phase.TRANSIT and now >= self._phase_end:
-            self.location, self.destination = self.destination, ''
-            self._free_at = self._phase_end
-            self._phase = _Phase.NEXT
-            return True
-        if self._phase == _Phase.TRAVEL and now >= self._phase_end:
+        if self._phase in (_Phase.TRAVEL, _Phase.TRANSIT):
+            arrival = self._arrival(now, events)
+            if arrival is None:
+                return False
+            self.location, self.destination, self._leg = self.destination, '', None
+            if self._phase == _Phase.TRANSIT:
+                self._free_at = arrival
+                self._phase = _Phase.NEXT
+                return True
             task = self.task
-            self.location, self.destination = task.location, ''
             self._phase = _Phase.WAIT
-            self._record(self._arrived, (self.robot, task.job), task.job, self._phase_end,
+            self._record(self._arrived, (self.robot, task.job), task.job, arrival,
                          self.revision)
-            events.append(Event(EventKind.ARRIVED, task.job, self._phase_end,
+            events.append(Event(EventKind.ARRIVED, task.job, arrival,
                                 self._attempts[task.job]))
             return True
         if self._phase == _Phase.WAIT:
@@ -461,15 +516,25 @@ class RobotExecution:
             self._phase, self._holding = _Phase.WORK, ''
             self._work_factor, self._factor = self._factor, 1.0
             self._phase_start = start
-            self._phase_end = later(start + task.duration * self._work_factor)
+            self.driver.begin(Operation(task.job, task.operation_type, task.operation_name,
+                                        task.location, task.co_workers,
+                                        task.duration * self._work_factor), start)
+            self._begun = True
             events.append(Event(EventKind.STARTED, task.job, start, self._attempts[task.job]))
             return True
-        if self._phase == _Phase.WORK and now >= self._phase_end:
+        if self._phase == _Phase.WORK:
+            ending = self.driver.ending(now)
+            if ending is None:
+                return False
+            self._begun = False
+            if ending.failure:
+                return self._driver_failed(ending, events)
             task = self.task
-            self._record(self._operation_done, (self.robot, task.job), task.job,
-                         self._phase_end, self.revision)
+            end = max(ending.end, self._phase_start)
+            self._record(self._operation_done, (self.robot, task.job), task.job, end,
+                         self.revision)
             self._phase = _Phase.FINISH
-            events.append(Event(EventKind.OPERATION_DONE, task.job, self._phase_end,
+            events.append(Event(EventKind.OPERATION_DONE, task.job, end,
                                 self._attempts[task.job]))
             return True
         if self._phase == _Phase.FINISH:
@@ -481,6 +546,40 @@ class RobotExecution:
             self._index += 1
             self._phase = _Phase.NEXT
             return True
+        return False
+
+    def _arrival(self, now: float, events: list[Event]) -> float | None:
+        """When the leg under way arrived, once it has by `now`; sets the leg off when due."""
+        if not self._begun:
+            if now < self._phase_start:
+                return None
+            if self._leg is None:
+                return self._phase_start
+            self.driver.begin(self._leg, self._phase_start)
+            self._begun = True
+        ending = self.driver.ending(now)
+        if ending is None:
+            return None
+        if ending.failure:
+            self._begun = False
+            self._driver_failed(ending, events)
+            return None
+        self._begun = False
+        return max(ending.end, self._phase_start)
+
+    def _driver_failed(self, ending: Ending, events: list[Event]) -> bool:
+        """The robot cannot go on: it fails as an injected failure makes it, where the
+        driver left it."""
+        if self._phase in (_Phase.TRAVEL, _Phase.TRANSIT):
+            # The robot stands where the driver says it stopped.
+            if ending.share > 0:
+                self._stopped = (self._leg, min(ending.share, 1.0))
+            else:
+                self.destination = ''
+        message = self._fail(ending.end, f"robot '{self.robot}' failed: {ending.failure}",
+                             events)
+        self._driver_failures.append(f"robot '{self.robot}' failed at t={ending.end:.2f} "
+                                     f'({ending.failure}){message}')
         return False
 
     def _next(self) -> bool:
@@ -497,14 +596,26 @@ class RobotExecution:
         # first leg of a mission leaves no earlier than the plan has it leave: its release
         # time (or the job's start for a robot not placed), which only the plan knows.
         # A holder carries the held part along its leg. A robot already at the job's place
-        # (a leg it ended under an older revision took it there) has no way left to go.
-        leg = 0.0 if self.location == task.location else max(task.leg, 0.0)
+        # (a leg it ended under an older revision took it there) has no way left to go; one
+        # standing on a leg has the plan's way from there, and at least what remains of the
+        # leg to either of its ends.
+        leg = max(task.leg, 0.0)
+        if self._stopped is None and self.location == task.location:
+            leg = 0.0
+        elif self._stopped is not None:
+            stopped, share = self._stopped
+            if task.location == stopped.destination:
+                leg = max(leg, (1 - share) * stopped.duration)
+            elif task.location == stopped.origin:
+                leg = max(leg, share * stopped.duration)
         if not self._departed:
             departure = max(departure, task.travel_start)
             self._departed = True
         self._phase = _Phase.TRAVEL
         self._phase_start = departure
-        self._phase_end = later(departure + leg) if leg > 0 else departure
+        self._stopped = None
+        self._leg = Leg(task.job, self.location, task.location, leg) if leg > 0 else None
+        self._begun = False
         self.destination = task.location
         return True
 

@@ -239,6 +239,20 @@ def test_failure_replans_without_the_robot(problem):
     assert published.revision == 2 and 'MARC1' not in published.result.schedule.sequences
 
 
+def test_a_projected_makespan_drifting_past_the_threshold_replans(problem):
+    """No robot reports starting anything: the plan slips with the clock. With a drift
+    threshold of 10 %, the rest is re-planned once the projection passes 32 * 1.1 = 35.2,
+    and not before; without one (the default), never."""
+    fleet = executing(problem, replace(SETTINGS, drift_threshold=0.1))
+    assert not kinds(fleet.tick(advance=2.0), Solve)
+    requests = kinds(fleet.tick(advance=3.0), Solve)
+    assert len(requests) == 1 and requests[0].kind == SolveKind.REPAIR
+    (reason,) = requests[0].reasons
+    assert reason.startswith('projected makespan 35.') and "past the plan's 32.00" in reason
+    steady = executing(problem)
+    assert not kinds(steady.tick(advance=5.0), Solve)
+
+
 def test_failure_and_recovery_between_two_ticks_still_replans(problem):
     """The recovered agent dropped its tasks: it must be planned in again, though it looks
     as healthy as before."""

@@ -14,8 +14,11 @@ A failure turns the executing mission into a smaller problem posed at `now`:
 - a completed jig job whose held job has not finished (not started, or aborted) and whose
   holders never failed since it began stays as a `FixedJob` of just its holders: the holders
   are still holding, and only its holding arc forces them to go directly to the held job;
-- every healthy robot starts where it is, or where it is travelling to, released at
-  max(now, free_at); a failed robot is left out, so it gets nothing.
+- every healthy robot starts where it is, released at max(now, free_at); a failed robot is
+  left out, so it gets nothing. A robot on a leg, or stopped on one, starts at the point of
+  the leg it has reached (a `Waypoint`), from which the plan may send it anywhere: it need not
+  drive to the end of a leg no task needs any more. A robot carrying a held part to the job it
+  holds into starts there, at its arrival.
 
 A job the healthy robots cannot staff is reported in `Residual.blocked`, never raised: the
 robot may come back, and a later state then gives a solvable residual. Holds that leave no
@@ -59,6 +62,43 @@ class StateError(ValueError):
         super().__init__('\n'.join(self.problems))
 
 
+WAYPOINT_SHARES = 100
+"""A point on a leg is placed at the share of the leg behind it rounded down to a hundredth:
+no further than the robot got, and a grid coarse enough to keep CP-SAT's time grid exact."""
+
+
+@dataclass(frozen=True)
+class Waypoint:
+    """A point on the way between two places: `share` of the way from `origin` to
+    `destination` (0 <= share < 1), where a robot on (or stopped on) that leg stands.
+
+    Its distance to a place is the shorter of two ways the robot can surely drive: back to
+    the origin, or on to the destination, and from there as the problem's distances say. It
+    is exact where the leg is the shortest way between its ends, never shorter than a way the
+    robot has, and so never lets a plan start a job before the robot can get there; the
+    executed timeline holds whichever way the robot takes (docs/robot-drivers.md)."""
+
+    origin: str
+    destination: str
+    share: Fraction
+
+    @classmethod
+    def reached(cls, origin: str, destination: str, progress: float) -> 'Waypoint':
+        """The point of the leg a robot reporting `progress` (0..1) has reached, at least."""
+        steps = min(max(int(progress * WAYPOINT_SHARES), 0), WAYPOINT_SHARES - 1)
+        return cls(origin, destination, Fraction(steps, WAYPOINT_SHARES))
+
+    @property
+    def name(self) -> str:
+        """As a location of a re-planned problem (and a plan's start location)."""
+        return f'{self.origin}->{self.destination}@{float(self.share):.2f}'
+
+    def distance(self, problem: Problem, place: str) -> Fraction:
+        leg = problem.distance(self.origin, self.destination)
+        return min(self.share * leg + problem.distance(self.origin, place),
+                   (1 - self.share) * leg + problem.distance(self.destination, place))
+
+
 @dataclass(frozen=True)
 class RobotSituation:
     """Where a robot stands as re-planning starts: whether it can work, where and from when.
@@ -72,6 +112,9 @@ class RobotSituation:
     """When it can start something new: the end of its running job, or its arrival."""
     last_failure: Fraction | None = None
     """When it last became failed or offline, even if it is healthy again; None: never."""
+    on_way: Waypoint | None = None
+    """Where on a leg it is, travelling (then at least this far) or stopped; `location` is
+    the leg's destination and `free_at` its arrival there."""
 
 
 @dataclass(frozen=True)
@@ -501,7 +544,7 @@ def _pose(problem, state, healthy, todo, fixed, kept, began, carried_to, aborted
     for name in aborted:
         freed.update(dict.fromkeys(state.running[name].robots, problem.job(name).location))
 
-    robots = []
+    robots, waypoints = [], {}
     for robot in problem.robots:
         if robot.name not in healthy:
             continue
@@ -509,6 +552,15 @@ def _pose(problem, state, healthy, todo, fixed, kept, began, carried_to, aborted
         location, release = s.location, max(now, s.free_at)
         if robot.name in freed:
             location, release = freed[robot.name], now
+        elif s.on_way is not None and robot.name not in place:
+            # It is free to turn where it is: as early as the rest of the leg allows.
+            way = s.on_way
+            rest = (1 - way.share) * problem.travel(robot.name, way.origin, way.destination)
+            location, release = way.name, max(now, s.free_at - rest)
+            if way.share == 0:
+                location = way.origin
+            else:
+                waypoints[way.name] = way
         # A robot's route begins at its fixed job, which is exempt from start-location travel.
         location = place.get(robot.name, location)
         robots.append(Robot(robot.name, robot.type, robot.speed, location, release))
@@ -537,7 +589,7 @@ def _pose(problem, state, healthy, todo, fixed, kept, began, carried_to, aborted
         robot_types=problem.robot_types,
         robots=tuple(robots),
         jobs=tuple(jobs),
-        distances=problem.distances,
+        distances=_with_waypoints(problem, waypoints),
         precedence=precedence,
         holding=holding,
         locomote=problem.locomote,
@@ -545,6 +597,29 @@ def _pose(problem, state, healthy, todo, fixed, kept, began, carried_to, aborted
         fixed=pinned,
         name=f'{problem.name}@{decimal(now)}',
     )
+
+
+def _with_waypoints(problem: Problem, waypoints: Mapping[str, Waypoint]) -> Mapping:
+    """The problem's distances, and those of the waypoints robots start at to every place
+    and to each other (through an end of each leg)."""
+    if not waypoints:
+        return problem.distances
+    distances = dict(problem.distances)
+    places = problem.locations()
+    for name, way in waypoints.items():
+        for place in places:
+            distances[name, place] = distances[place, name] = way.distance(problem, place)
+    for a, first in waypoints.items():
+        for b, second in waypoints.items():
+            if a != b:
+                distances[a, b] = min(
+                    end_share + second.distance(problem, end)
+                    for end, end_share in (
+                        (first.origin, first.share * problem.distance(first.origin,
+                                                                      first.destination)),
+                        (first.destination, (1 - first.share) * problem.distance(
+                            first.origin, first.destination))))
+    return distances
 
 
 def _hold_end(problem, state, source, holders, carried_to) -> Fraction:
@@ -605,6 +680,18 @@ def _raise_on_state_problems(problem: Problem, state: ExecutionState) -> None:
             problems.append(f"robot state under '{name}' is named '{r.name}'")
         if r.location is not None and r.location not in locations:
             problems.append(f"robot '{name}' is at unknown location '{r.location}'")
+        if r.on_way is not None:
+            way = r.on_way
+            for end in (way.origin, way.destination):
+                if end not in locations:
+                    problems.append(f"robot '{name}' is on its way from or to unknown "
+                                    f"location '{end}'")
+            if way.name in locations:
+                problems.append(f"robot '{name}' is on its way at '{way.name}', which is "
+                                'the name of a location too')
+            if not 0 <= way.share < 1:
+                problems.append(f"robot '{name}' is {way.share} of its way from "
+                                f"'{way.origin}' to '{way.destination}': not within [0, 1)")
     for name in sorted(robots - set(state.robots)):
         problems.append(f"no state for robot '{name}'")
     if problems:

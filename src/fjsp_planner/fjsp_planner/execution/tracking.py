@@ -23,7 +23,7 @@ from fractions import Fraction
 from fjsp_common.decimals import decimal, decimals
 from fjsp_common.revisions import void
 from fjsp_common.vocabulary import EventKind, RobotMode
-from fjsp_planner.execution.replan import ExecutionState, RobotSituation
+from fjsp_planner.execution.replan import ExecutionState, RobotSituation, Waypoint
 from fjsp_planner.model.limits import shown
 from fjsp_planner.model.problem import Problem
 from fjsp_planner.model.schedule import JobAssignment, Schedule
@@ -81,6 +81,8 @@ class RobotRecord:
     location: str = ''
     destination: str = ''
     busy_until: float = math.nan
+    progress: float = math.nan
+    """Share of the leg from `location` to `destination` behind it (NaN: not said)."""
     current_job: str = ''
     reported: bool = False
     failures: int = 0
@@ -271,13 +273,14 @@ class MissionTracker:
 
     def record_robot_state(self, robot: str, mode: str, location: str, destination: str,
                            busy_until: float, current_job: str = '',
-                           at: float | None = None) -> Verdict:
+                           at: float | None = None, progress: float = math.nan) -> Verdict:
         """Use a robot's state report (or heartbeat) observed at schedule time `at`.
 
         A report that turns a healthy robot failed or offline counts a failure at `at` (by
         default: the latest time any event reported). A `busy_until` that is not a finite
-        non-negative number reads as NaN (not said). A report naming an unknown robot or
-        place is ignored, and counted once however often it repeats. Never raises.
+        non-negative number, or a `progress` not within [0, 1], reads as NaN (not said). A
+        report naming an unknown robot or place is ignored, and counted once however often it
+        repeats. Never raises.
         """
         problem = self._state_problem(robot, mode, location, destination, current_job)
         if problem is not None:
@@ -293,6 +296,7 @@ class MissionTracker:
         record.mode, record.destination = mode, destination
         record.location = location or record.location
         record.busy_until = busy_until if _time_ok(busy_until) else math.nan
+        record.progress = progress if _share_ok(progress) else math.nan
         record.current_job, record.reported = current_job, True
         self._count_failure(record, was_healthy, at)
         return Verdict()
@@ -529,11 +533,21 @@ class MissionTracker:
         for name, r in self.robots.items():
             robot = self.problem.robot(name)
             on = [j for j, a in running.items() if name in a.robots]
+            on_way = None
             if on:
                 location, free_at = self.problem.job(on[0]).location, running[on[0]].end
             elif r.mode == RobotMode.TRAVELLING and r.destination:
                 arrival = r.busy_until if math.isfinite(r.busy_until) else now
                 location, free_at = r.destination, max(Fraction(arrival), now_f)
+                on_way = self._on_way(r)
+            elif r.healthy and r.location and r.destination:
+                # Stopped on a leg (a new plan no longer needed it, or it failed there):
+                # it would take the rest of the leg to its destination.
+                on_way = self._on_way(r)
+                share = on_way.share if on_way is not None else Fraction(0)
+                location = r.destination
+                free_at = now_f + (1 - share) * self.problem.travel(name, r.location,
+                                                                   r.destination)
             else:
                 # An agent reports no location until its first leg places it: until then
                 # it is where its last job left it (an agent restarted under a planner
@@ -542,10 +556,19 @@ class MissionTracker:
             # Nor is it free before its release time, however idle it looks.
             free_at = max(free_at, Fraction(robot.release_time))
             failed_at = None if r.last_failure_at is None else Fraction(r.last_failure_at)
-            robots[name] = RobotSituation(name, r.healthy, location, free_at, failed_at)
+            robots[name] = RobotSituation(name, r.healthy, location, free_at, failed_at,
+                                          on_way)
         done_as = {name: self.jobs[name].done_as for name in self.done
                    if self.jobs[name].done_as is not None}
         return ExecutionState(now_f, self.done, running, robots, done_as)
+
+    @staticmethod
+    def _on_way(r: RobotRecord) -> Waypoint | None:
+        """The point of its leg a robot has reached, by its last report (None: not said)."""
+        if not (r.location and r.destination and r.location != r.destination
+                and math.isfinite(r.progress)):
+            return None
+        return Waypoint.reached(r.location, r.destination, r.progress)
 
     def _last_place(self, robot: str) -> str | None:
         """Where the last job the robot completed is, else where the mission starts it."""
@@ -583,19 +606,25 @@ class MissionTracker:
     def _as_executed(self, executed: Schedule) -> Problem:
         """The problem restricted to the executed jobs, operations free of duration and
         distances relaxed to shortest routes where the direct one does not fit."""
-        p = self.problem
+        p = without_durations(self.problem)
         done = set(executed.jobs)
-        locomote = p.locomote
         return dataclasses.replace(
             p, jobs=tuple(j for j in p.jobs if j.name in done),
             precedence=tuple((a, b) for a, b in p.precedence if a in done and b in done),
             holding=tuple((a, b, q) for a, b, q in p.holding if a in done and b in done),
-            robot_types={name: {q: (t if q == locomote else Fraction(0))
-                                for q, t in times.items()}
-                         for name, times in p.robot_types.items()},
-            time_overrides=dict.fromkeys(p.time_overrides, Fraction(0)),
             distances=relaxed_distances(p, executed), fixed={}, panels=(),
             name=f'{p.name} as executed')
+
+
+def without_durations(problem: Problem) -> Problem:
+    """`problem` with every operation free of duration: how a timeline whose operations
+    lasted as long as the robots took is judged. Each robot's operations are overridden with
+    0 (those of the locomote type too, as the paper's moves are), while travel, which reads
+    the robot type's efficiency, keeps its time."""
+    return dataclasses.replace(problem, time_overrides={
+        **dict.fromkeys(problem.time_overrides, Fraction(0)),
+        **{(r.name, q): Fraction(0) for r in problem.robots
+           for q in problem.robot_types.get(r.type, {})}})
 
 
 def relaxed_distances(problem: Problem, executed: Schedule) -> dict:
@@ -617,6 +646,11 @@ def relaxed_distances(problem: Problem, executed: Schedule) -> dict:
     for a, b in legs:
         distances[a, b] = distances[b, a] = location_distance(problem, a, b)
     return distances
+
+
+def _share_ok(value) -> bool:
+    return (isinstance(value, numbers.Real) and not isinstance(value, bool)
+            and 0 <= value <= 1)
 
 
 def _time_ok(value) -> bool:

@@ -104,6 +104,11 @@ def parse_arguments(argv) -> argparse.Namespace:
     parser.add_argument('--web-port', type=_port, metavar='PORT',
                         help="port of the monitor's live page (default: the params file's, "
                              'else 8080; 0: no page)')
+    parser.add_argument('--sim-robots', action='store_true',
+                        help='drive every robot through its action servers, served by a '
+                             'simulated robot (sim_robot) per robot; its noise and failures '
+                             'come from the params file (spread, bias, failure_rate, seed; '
+                             'docs/robot-drivers.md)')
     return parser.parse_args(argv)
 
 
@@ -124,7 +129,8 @@ def run(args: argparse.Namespace) -> int:
     try:
         fleet = Fleet(args.scenario, panels=args.panels, time_scale=args.time_scale,
                       params_file=args.params_file, out=args.out, monitor=monitor,
-                      key=not args.unauthenticated, resumable=True)
+                      key=not args.unauthenticated, resumable=True,
+                      sim_robots={} if args.sim_robots else None)
     except FleetError as error:
         print(f'fleet: cannot run {args.scenario}:', file=sys.stderr)
         for problem in error.problems:

@@ -25,7 +25,13 @@ from pathlib import Path
 from ament_index_python.packages import get_package_prefix
 
 from fjsp_common.auth import KEY_FILE_VARIABLE, new_key
-from fjsp_common.fleet import MONITOR_NODE, PLANNER_NODE, RECORDER_NODE, agent_node_name
+from fjsp_common.fleet import (
+    MONITOR_NODE,
+    PLANNER_NODE,
+    RECORDER_NODE,
+    agent_node_name,
+    sim_robot_node_name,
+)
 from fjsp_planner.launcher.params import (
     read_params_file,
     ros_string,
@@ -134,6 +140,10 @@ class Fleet:
     parameters file sets where: a planner started again resumes the mission and nothing done
     is redone (docs/ros-interfaces.md, "Journal and planner restart").
 
+    With `sim_robots` (a dict of `sim_robot` parameters, maybe empty) every agent runs with
+    the `action` driver, and a `sim_robot` node serves the actions of each robot, started
+    with its agent (docs/robot-drivers.md).
+
     Start nodes from a thread that lives as long as the fleet (the main thread): the kernel
     sends the parent-death signal when the thread that started a node ends.
     """
@@ -143,7 +153,8 @@ class Fleet:
                  domain: int | None = None, env: dict | None = None,
                  planner: dict | None = None, agents: dict | None = None,
                  monitor: dict | None = None, key: bool = False,
-                 prefixes: dict | None = None, resumable: bool = False):
+                 prefixes: dict | None = None, resumable: bool = False,
+                 sim_robots: dict | None = None):
         problems = []
         self.scenario = resolve_scenario(scenario)
         self.problem: Problem | None = None
@@ -164,9 +175,11 @@ class Fleet:
         if self.params_file is not None:
             self.params, unusable = read_params_file(self.params_file)
             problems += unusable
-        for package, executable in (('fjsp_planner', 'planner_node'),
-                                    ('fjsp_planner', 'monitor_node'),
-                                    ('robot_agents', 'robot_agent')):
+        executables = [('fjsp_planner', 'planner_node'), ('fjsp_planner', 'monitor_node'),
+                       ('robot_agents', 'robot_agent')]
+        if sim_robots is not None:
+            executables.append(('robot_agents', 'sim_robot'))
+        for package, executable in executables:
             try:
                 find_executable(package, executable)
             except FleetError as error:
@@ -204,6 +217,7 @@ class Fleet:
                        for r in self.problem.robots):
                 self.extra['agents'].setdefault(REPORTS_PARAMETER, journal)
         self.prefixes = {name: list(prefix) for name, prefix in (prefixes or {}).items()}
+        self.sim_robots = dict(sim_robots) if sim_robots is not None else None
         self.processes: dict[str, subprocess.Popen] = {}
         self._starts: dict[str, tuple] = {}
         """How each node was last started: the arguments of `start_node`."""
@@ -236,12 +250,20 @@ class Fleet:
     def start_agent(self, robot: str, executable: str = 'robot_agent',
                     **params) -> subprocess.Popen:
         """The agent of `robot` (`robot_agent`, or a type-pinning alias such as
-        `marc_agent`); it need not be a robot of the scenario."""
+        `marc_agent`); it need not be a robot of the scenario. With `sim_robots`, its
+        simulated robot too, unless it runs already."""
         # The agent reads robot_name before its node, named after it, exists: a `-p`
         # value (for every node of the process) reaches it there.
+        name_arg = ('-p', f'robot_name:={ros_string(robot)}')
+        own = {}
+        if self.sim_robots is not None:
+            own['driver'] = 'action'
+            sim = self.processes.get(sim_robot_node_name(robot))
+            if sim is None or sim.poll() is not None:
+                self.start_node(sim_robot_node_name(robot), 'robot_agents', 'sim_robot',
+                                self.sim_robots, ros_args=name_arg)
         return self.start_node(agent_node_name(robot), 'robot_agents', executable,
-                               {**self.extra['agents'], **params},
-                               ros_args=('-p', f'robot_name:={ros_string(robot)}'))
+                               {**own, **self.extra['agents'], **params}, ros_args=name_arg)
 
     def start_monitor(self, stream: bool = False, **params) -> subprocess.Popen:
         """The monitor; with `stream`, its output goes to this process's stdout too."""

@@ -701,7 +701,7 @@ class PlannerNode(Node):
             robot=msg.robot, mode=mode, incarnation=msg.incarnation, mission_id=msg.mission_id,
             revision=msg.plan_revision, refusal=msg.refusal, failures=msg.failures,
             robot_type=msg.robot_type, location=msg.location, destination=msg.destination,
-            busy_until=msg.busy_until, current_job=msg.current_job,
+            busy_until=msg.busy_until, progress=msg.progress, current_job=msg.current_job,
             last_event=msg.last_event_id)
         self.carry_out(self.controller.robot_state(report, self.wall()))
 

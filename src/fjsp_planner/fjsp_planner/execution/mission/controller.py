@@ -381,7 +381,8 @@ class MissionController:
         before = mission.tracker.robots[report.robot].mode
         mission.tracker.record_robot_state(report.robot, report.mode, report.location,
                                            report.destination, report.busy_until,
-                                           report.current_job, at=self._units(mission, wall))
+                                           report.current_job, at=self._units(mission, wall),
+                                           progress=report.progress)
         if report.mode == RobotMode.FAILED and before != RobotMode.FAILED:
             effects.append(Note(MissionEventKind.ROBOT_FAILED, robot=report.robot))
         elif before == RobotMode.FAILED and report.mode != RobotMode.FAILED:
@@ -795,7 +796,21 @@ class MissionController:
             tracker = mission.tracker
             reasons += [f"job '{j}' aborted" for j in sorted(tracker.aborted)]
             reasons += tracker.overruns(self.settings.delay_threshold)
+            reasons += self._drift(mission, wall)
         return reasons
+
+    def _drift(self, mission: Mission, wall: float) -> list[str]:
+        """The projected makespan past the plan's by more than `drift_threshold` (a share; 0:
+        never): robots running late (or short) enough that the rest may be better planned
+        afresh from where they are. Each revision resets the plan's makespan."""
+        share, planned = self.settings.drift_threshold, mission.planned_makespan
+        if share <= 0 or not math.isfinite(planned) or planned <= 0:
+            return []
+        projected = float(mission.tracker.projected_makespan(self._units(mission, wall)))
+        if projected <= planned * (1 + share):
+            return []
+        return [f'projected makespan {projected:.2f} is {projected / planned - 1:.1%} past '
+                f"the plan's {planned:.2f}"]
 
     # --- ends ------------------------------------------------------------------------------
 

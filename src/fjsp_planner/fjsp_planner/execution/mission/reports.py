@@ -21,6 +21,7 @@ class RobotReport:
     location: str = ''
     destination: str = ''
     busy_until: float = math.nan
+    progress: float = math.nan
     current_job: str = ''
     last_event: str = ''
     """The id of the latest task event the agent published ('' if none)."""

@@ -31,6 +31,9 @@ PARAMETERS = table(
     ParameterSpec('delay_threshold', 2.0,
                   'schedule units an operation may run late before a re-plan', low=0.0,
                   high=1e6, read_only=False),
+    ParameterSpec('drift_threshold', 0.0,
+                  "share by which the projected makespan may exceed the plan's before the "
+                  'rest is re-planned; 0: never', low=0.0, high=10.0, read_only=False),
     ParameterSpec('robot_wait_timeout', 15.0,
                   'seconds to wait for every robot to report before planning without it',
                   low=0.0, high=3600.0, read_only=False),
@@ -73,6 +76,7 @@ class Settings:
     replan_time_limit: float = _default('replan_time_limit')
     heartbeat_timeout: float = _default('heartbeat_timeout')
     delay_threshold: float = _default('delay_threshold')
+    drift_threshold: float = _default('drift_threshold')
     robot_wait_timeout: float = _default('robot_wait_timeout')
     start_delay: float = _default('start_delay')
     time_scale: float = _default('time_scale')
