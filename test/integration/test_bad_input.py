@@ -37,7 +37,7 @@ from repo_paths import PAPER
     (['run', 'fjsp_planner', 'fleet', 'truss', '--time-scale', 'fast'], 2,
      "argument --time-scale: expected a number > 0, got 'fast'"),
     (['run', 'fjsp_planner', 'fleet', 'truss', '--params-file', '/no/such.yaml'], 2,
-     '/no/such.yaml: cannot read parameters file: No such file or directory'),
+     '/no/such.yaml: no such file'),
     (['bag', 'info', 'x.mcap'], 2, 'not provided by this front end'),
     (['topic', 'echo', '/plan', '--spin-time', '-1'], 2, '--spin-time must be >= 0'),
 ])
