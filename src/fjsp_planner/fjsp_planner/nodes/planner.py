@@ -61,8 +61,10 @@ from fjsp_planner.execution.journal import (
     EndRecord,
     JobsAddedRecord,
     Journal,
+    JournalError,
     MissionRecord,
     PlanRecord,
+    journal_directory,
     journal_path,
     journals,
 )
@@ -89,6 +91,9 @@ ANSWERS_KEPT = 256
 """Answers kept per service for requests that are resent."""
 
 SOLVER_NICENESS = 10
+
+JOURNAL_RETRY = 5.0
+"""Seconds between attempts to resume a mission whose journal could not be written."""
 
 
 def yield_to_the_fleet() -> None:
@@ -159,7 +164,12 @@ class PlannerNode(Node):
         self.solver = value['solver']
         self.time_scale, self.start_delay = value['time_scale'], value['start_delay']
         status_period, journal_dir = value['status_period'], value['journal_dir']
-        self.journal_dir = Path(journal_dir).expanduser() if journal_dir else None
+        self.journal_dir = None
+        if journal_dir:
+            try:
+                self.journal_dir = journal_directory(journal_dir)
+            except JournalError as error:
+                raise ParameterError(f"parameter 'journal_dir': {error}") from None
         problem = None
         if scenario:
             try:
@@ -175,6 +185,9 @@ class PlannerNode(Node):
         self.auth = NodeAuth(self, PLANNER_NODE)
         self.controller = MissionController(self.settings())
         self.journal: Journal | None = None
+        self.journal_blocked: tuple[str, str, float] | None = None
+        """(mission, why, when) of a mission set aside because its journal could not be
+        written: resumed from the journal once it can be."""
         self.goal: Goal | None = None
         self.job_done_ids: set[str] = set()
         self.solver_answer: tuple[str, float | None] = ('', None)
@@ -233,8 +246,12 @@ class PlannerNode(Node):
             self.get_logger().info(f"scenario '{problem.name}' from {scenario}: "
                                    f'{len(problem.jobs)} jobs, robots '
                                    + ', '.join(r.name for r in problem.robots))
-            self.start_mission(problem, text, problem.name, panels, shift, origin,
-                               self.settings())
+            try:
+                self.start_mission(problem, text, problem.name, panels, shift, origin,
+                                   self.settings())
+            except JournalError as error:
+                raise ParameterError(f"parameter 'journal_dir': cannot start '{scenario}': "
+                                     f'{error}') from None
 
     # --- parameters and time -------------------------------------------------------------
 
@@ -249,12 +266,27 @@ class PlannerNode(Node):
 
     def start_mission(self, problem, text, name, panels, shift, origin, settings) -> str:
         """Start a mission (ValueError while another one runs); its id."""
+        if self.journal_blocked is not None:
+            raise ValueError(f"mission '{self.journal_blocked[0]}' is set aside until its "
+                             'journal can be written: one mission per fleet at a time')
         mission_id = new_mission_id(problem.name)
-        effects = self.controller.start(problem, mission_id, self.wall(), settings)
+        journal = None
         if self.journal_dir is not None:
-            self.journal = Journal(journal_path(self.journal_dir, mission_id))
-            self.journal.write(MissionRecord(
-                mission_id, text, name, panels, shift, origin, settings.__dict__, self.wall()))
+            # A mission whose journal cannot be written is refused before it starts.
+            journal = Journal(journal_path(self.journal_dir, mission_id))
+            try:
+                journal.write(MissionRecord(mission_id, text, name, panels, shift, origin,
+                                            settings.__dict__, self.wall()))
+            except JournalError:
+                journal.discard()
+                raise
+        try:
+            effects = self.controller.start(problem, mission_id, self.wall(), settings)
+        except ValueError:
+            if journal is not None:
+                journal.discard()
+            raise
+        self.journal = journal
         self.get_logger().info(f"mission '{mission_id}' accepted")
         self.carry_out(effects)
         return mission_id
@@ -270,9 +302,12 @@ class PlannerNode(Node):
             return ''
         log = self.get_logger()
         for path, _ in unfinished[:-1]:
-            with_end = Journal(path)
-            with_end.write(EndRecord('failed', ('abandoned: a newer mission was resumed',)))
-            with_end.close()
+            try:
+                with_end = Journal(path)
+                with_end.write(EndRecord('failed', ('abandoned: a newer mission was resumed',)))
+                with_end.close()
+            except JournalError as error:
+                log.warning(f'cannot close an abandoned mission: {error}')
         path, records = unfinished[-1]
         head: MissionRecord = records[0]
         try:
@@ -286,10 +321,17 @@ class PlannerNode(Node):
             log.error(f'cannot resume the mission of {path}: ' + '; '.join(error.problems))
             return ''
         settings = Settings(**{**self.settings().__dict__, **head.settings})
-        self.journal = Journal(path)
+        try:
+            self.journal = Journal(path)
+        except JournalError as error:
+            self.journal_blocked = (head.mission_id, f'cannot resume: {error}', self.wall())
+            log.error(f"mission '{head.mission_id}' {self.journal_blocked[1]}")
+            return head.origin
         log.warning(f"resuming mission '{head.mission_id}' from {path}")
         self.carry_out(self.controller.resume(head.mission_id, problem, settings,
                                               head.accepted, records[1:], self.wall()))
+        if self.journal is None:
+            return head.origin  # set aside again
         self.publish_journaled_plan(head.mission_id)
         # The previous process's event history died with it, and a completion it published
         # just before it was killed may never have reached anyone: declared again, with its
@@ -505,7 +547,11 @@ class PlannerNode(Node):
             response.problems = [shorten(p, 500) for p in error.problems]
             return response
         if self.journal is not None:
-            self.journal.write(JobsAddedRecord(request.fragment_yaml, jobs))
+            try:
+                self.journal.write(JobsAddedRecord(request.fragment_yaml, jobs))
+            except JournalError as error:
+                response.message = f'{error}; the mission is unchanged'
+                return response
         self.carry_out(self.controller.add_jobs(problem, jobs, self.wall()))
         response.success, response.jobs = True, list(jobs)
         response.message = f"{len(jobs)} job(s) added to mission '{mission.id}'"
@@ -515,8 +561,10 @@ class PlannerNode(Node):
 
     def tick(self) -> None:
         self.controller.settings = self.settings()
-        if self.journal is not None:
-            self.journal.sync()
+        if self.journal_blocked is not None \
+                and self.wall() - self.journal_blocked[2] >= JOURNAL_RETRY:
+            self.journal_blocked = None
+            self.resume_unfinished()
         self.carry_out(self.controller.tick(self.wall(), self.plan_pub.get_subscription_count()))
 
     def on_robot_state(self, msg: RobotState) -> None:
@@ -623,25 +671,47 @@ class PlannerNode(Node):
     def carry_out(self, effects) -> None:
         if not effects:
             return
-        for effect in effects:
-            if isinstance(effect, Solve):
-                self.solve(effect)
-            elif isinstance(effect, PublishPlan):
-                self.publish_plan(effect)
-            elif isinstance(effect, ResendPlan):
-                self.resend_plan(effect)
-            elif isinstance(effect, JobDone):
-                self.publish_job_done(effect)
-            elif isinstance(effect, Note):
-                self.tell(effect)
-                if effect.kind in ENDINGS:
-                    self.end(ENDINGS[effect.kind], effect.reasons)
+        try:
+            for effect in effects:
+                if isinstance(effect, Solve):
+                    self.solve(effect)
+                elif isinstance(effect, PublishPlan):
+                    self.publish_plan(effect)
+                elif isinstance(effect, ResendPlan):
+                    self.resend_plan(effect)
+                elif isinstance(effect, JobDone):
+                    self.publish_job_done(effect)
+                elif isinstance(effect, Note):
+                    self.tell(effect)
+                    if effect.kind in ENDINGS:
+                        self.end(ENDINGS[effect.kind], effect.reasons)
+        except JournalError as error:
+            self.set_aside(error)
         self.publish_jobs()
         self.publish_status()
 
+    def set_aside(self, error: JournalError) -> None:
+        """The journal cannot take what the mission must record before the fleet hears it:
+        nothing more is published. The mission is dropped as a planner that died would drop
+        it, and resumed from its journal and the robots' histories (as after a restart) once
+        the journal can be written again; meanwhile the robots finish what they were given
+        and wait, and the status says why."""
+        mission = self.controller.forget()
+        self.journal.close()
+        self.journal = None
+        self.solves.clear()
+        self.journal_blocked = (mission.id, f'{error}; nothing more is planned or declared '
+                                f'done until it can be written (tried again every '
+                                f'{JOURNAL_RETRY:g} s)', self.wall())
+        self.get_logger().error(f"mission '{mission.id}' set aside: "
+                                f'{self.journal_blocked[1]}')
+
     def end(self, state: MissionState, reasons) -> None:
         if self.journal is not None:
-            self.journal.write(EndRecord(str(state), tuple(reasons)))
+            try:
+                self.journal.write(EndRecord(str(state), tuple(reasons)))
+            except JournalError as error:
+                self.get_logger().error(f'the end of the mission is not journaled: {error}')
             self.journal.close()
             plan_file(self.journal.path).unlink(missing_ok=True)
             self.journal = None
@@ -650,12 +720,6 @@ class PlannerNode(Node):
 
     def publish_plan(self, effect: PublishPlan) -> None:
         mission = self.controller.mission
-        if self.journal is not None:
-            # On disk before any robot can follow it.
-            self.journal.write(PlanRecord(
-                effect.revision, effect.mission_start,
-                None if effect.cancelled else effect.result.schedule, effect.continued,
-                effect.reasons, dict(effect.starts), dict(effect.incarnations)))
         stamp = self.get_clock().now().to_msg()
         start = Time(nanoseconds=int(effect.mission_start * 1e9)).to_msg()
         if effect.cancelled:
@@ -665,10 +729,16 @@ class PlannerNode(Node):
             msg = plan_msg(mission.problem, effect.posed, effect.result.schedule, effect.result,
                            mission.id, effect.revision, start, mission.settings.time_scale,
                            stamp, effect.restarted_in, effect.reasons, effect.incarnations)
+        if self.journal is not None:
+            # On disk before any robot can follow it; the message first: a restarted planner
+            # publishes it again only if the journal's latest revision is its own.
+            write_plan_file(plan_file(self.journal.path), msg)
+            self.journal.write(PlanRecord(
+                effect.revision, effect.mission_start,
+                None if effect.cancelled else effect.result.schedule, effect.continued,
+                effect.reasons, dict(effect.starts), dict(effect.incarnations)))
         self.last_published = (msg.mission_id, msg.revision, msg.stamp)
         self.last_plan = msg
-        if self.journal is not None:
-            write_plan_file(plan_file(self.journal.path), msg)
         self.plan_pub.publish(self.auth.sign(msg, PLAN_TOPIC))
         log = self.get_logger()
         if effect.cancelled:
@@ -780,6 +850,14 @@ class PlannerNode(Node):
 
     def publish_status(self) -> None:
         view = self.controller.status(self.wall())
+        if view is None and self.journal_blocked is not None:
+            mission_id, why, _ = self.journal_blocked
+            self.status_pub.publish(self.auth.sign(MissionStatus(
+                stamp=self.get_clock().now().to_msg(), mission_id=mission_id,
+                state=STATE_TO_MSG[MissionState.BLOCKED], blocked_reasons=[why],
+                planned_makespan=math.nan, projected_makespan=math.nan,
+                ignored_unauthenticated=self.auth.rejected), MISSION_STATUS_TOPIC))
+            return
         if view is None:
             # Heard by `mission status`, monitors and recorders before any mission: they
             # know the planner is there, waiting for one.
@@ -821,8 +899,13 @@ def write_plan_file(path: Path, msg: Plan) -> None:
     """`msg` in `path`, whole or not at all: a process killed while writing leaves the
     previous one."""
     partial = path.with_name(path.name + '.partial')
-    partial.write_bytes(serialize_message(msg))
-    partial.replace(path)
+    try:
+        partial.write_bytes(serialize_message(msg))
+        partial.replace(path)
+    except OSError as error:
+        partial.unlink(missing_ok=True)
+        raise JournalError(f'{path}: cannot write the plan: {error.strerror or error}'
+                           ) from None
 
 
 def main(args=None):

@@ -219,6 +219,13 @@ class MissionController:
         return [Note(MissionEventKind.MISSION_STARTED,
                      (f'resumed after a planner restart {where}',))] + self.tick(wall)
 
+    def forget(self) -> 'Mission':
+        """Drop the running mission from memory, as a planner process that dies drops it
+        (its journal and the robots' histories bring it back: `resume`); the mission
+        dropped."""
+        mission, self.mission = self.mission, None
+        return mission
+
     def _resume_when_caught_up(self, mission, wall) -> list[Effect]:
         """Re-plan a resumed mission once what the robots did while no planner ran is known:
         every robot heard has had the latest task event it says it published received (a
