@@ -6,7 +6,9 @@ Free of ROS, so the domain core and tools use them too:
 - `fleet`: node names and the defaults the whole fleet shares (heartbeat period and timeout);
 - `clock`: one mission's schedule clock, wall seconds <-> schedule units;
 - `revisions`: which attempt at a job a report is about, and whether it still counts;
-- `parameters`: a node parameter's one definition (`ParameterSpec`).
+- `parameters`: a node parameter's one definition (`ParameterSpec`);
+- `wellformed`: what a plan or event must hold to be acted on (times that are numbers, a
+  usable time scale), checked by every reader.
 
 With ROS:
 

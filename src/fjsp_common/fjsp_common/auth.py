@@ -11,6 +11,9 @@ but the planner publishing plans or job completions), or a counter that does not
 (a replay).
 
 Without a key nothing is signed or checked, and every node says so when it starts.
+
+The key files and the checking need no ROS (a recording is checked by `replay` on a machine
+without it); signing, and a node's parameter, import it when used.
 """
 
 import hashlib
@@ -24,9 +27,8 @@ import time
 from collections import Counter
 from pathlib import Path
 
+from fjsp_common.fleet import PLANNER_NODE
 from fjsp_common.parameters import ParameterSpec
-from fjsp_common.running import ParameterError, declare, shorten
-from fjsp_msgs.msg import Auth
 
 KEY_BYTES = 32
 KEY_FILE_VARIABLE = 'FJSP_FLEET_KEY_FILE'
@@ -81,9 +83,12 @@ def _digest(key: bytes, name: str, msg) -> bytes:
 def _canonical(value):
     """The message's content, field by field in definition order, floats exact. Not its CDR
     serialization: that carries whatever happened to be in memory in its padding bytes, so
-    the same message serializes differently from one call to the next."""
+    the same message serializes differently from one call to the next. A message decoded
+    from a recording (`mcap_ros2`) lists its fields in `__slots__`, in the same order."""
     if hasattr(value, 'get_fields_and_field_types'):
         return [_canonical(getattr(value, field)) for field in value.get_fields_and_field_types()]
+    if hasattr(value, '__slots__') and hasattr(value, '__dict__'):
+        return [_canonical(getattr(value, field)) for field in value.__slots__]
     if isinstance(value, bool | str):
         return value
     if isinstance(value, numbers.Integral):
@@ -93,6 +98,20 @@ def _canonical(value):
     if isinstance(value, bytes):
         return value.hex()
     return [_canonical(item) for item in value]
+
+
+def signers_of(msg, job_done: bool | None = None) -> frozenset[str]:
+    """Who may sign `msg` (a live message, or one decoded from a recording): the robot a
+    robot state, or a robot's task event, is about; the planner for everything else (plans,
+    job completions, mission events, statuses, job states). `job_done` says whether a task
+    event declares a job done; by default the message's class constant tells (a live message
+    has it, one decoded from a recording does not)."""
+    kind = type(msg).__name__
+    if kind == 'TaskEvent' and job_done is None:
+        job_done = msg.kind == getattr(type(msg), 'KIND_JOB_DONE', None)
+    if kind == 'RobotState' or (kind == 'TaskEvent' and not job_done):
+        return frozenset({msg.robot})
+    return frozenset({PLANNER_NODE})
 
 
 def client_signer(key_file, sender: str) -> 'Signer':
@@ -114,6 +133,8 @@ class Signer:
     def sign(self, msg, name: str):
         """`msg` with its `auth` filled for resolved topic or service `name`; unchanged
         without a key."""
+        from fjsp_msgs.msg import Auth
+
         if self.key is None:
             return msg
         self._counters[name] += 1
@@ -163,6 +184,8 @@ class NodeAuth:
     the node resolves them, and one warning per sender and reason for what is dropped."""
 
     def __init__(self, node, sender: str):
+        from fjsp_common.running import ParameterError, declare
+
         self.node = node
         path = declare(node, FLEET_KEY_FILE)
         key = None
@@ -207,7 +230,7 @@ class NodeAuth:
         if not why:
             return True
         kind = why.split(':')[0].split("'")[0]
-        key = (name, shorten(msg.auth.sender, 80), kind)
+        key = (name, msg.auth.sender[:80], kind)
         if key not in self._warned:
             self._warned.add(key)
             self.node.get_logger().warning(f'dropping an unauthenticated message on {name} '

@@ -34,6 +34,12 @@ ACTIVITY_STYLE = {
     'holding': {'color': 'royalblue', 'linewidth': 3.0, 'linestyle': '-'},
 }
 HEALTH_COLOUR = {'failed': ('red', 0.14), 'offline': ('grey', 0.28)}
+MAX_ROWS = 100
+"""Robots drawn, in the timeline's order."""
+MAX_NOTES = 12
+"""Revisions whose reasons are listed under the chart."""
+LABEL = 30
+"""Characters of a robot's name shown."""
 
 
 def job_colours(jobs) -> dict:
@@ -43,7 +49,9 @@ def job_colours(jobs) -> dict:
 
 def draw_mission(timeline: dict, header: dict, path: Path) -> Path:
     """Write the chart of `timeline` (from `views.timeline`) to `path` (PNG); returns it."""
-    robots = timeline['robots']
+    # What a figure can hold whatever a recording names: a forged flood of robot names or
+    # of re-plans must not make an image too large to draw.
+    robots = timeline['robots'][:MAX_ROWS]
     rows = {robot: len(robots) - 1 - index for index, robot in enumerate(robots)}
     end = max(timeline['end'] or 1.0, 1.0)
     now_units = timeline['now']
@@ -52,12 +60,16 @@ def draw_mission(timeline: dict, header: dict, path: Path) -> Path:
     notes = [f"r{r['number']} at t={r['time']:.1f}: "
              + ('; '.join(r['reasons']) or 'no reason given')
              for r in timeline['revisions'] if r['number'] > 1 and r['time'] is not None]
+    if len(notes) > MAX_NOTES:
+        notes = notes[:MAX_NOTES - 1] + [f'... and {len(notes) - MAX_NOTES + 1} more '
+                                         'revisions']
+    notes = [_cut(note, 300) for note in notes]
     # Heights in inches: title, one per robot, axis and legend, a line per revision's reasons.
     below = 1.1 + 0.17 * len(notes)
     height = 0.65 + 0.95 * len(robots) + below
     width = min(28.0, max(11.0, 0.1 * end + 7))
     fig, ax = plt.subplots(figsize=(width, height))
-    label = 0.2 + 0.075 * max((len(r) for r in robots), default=4)
+    label = 0.2 + 0.075 * max((min(len(r), LABEL) for r in robots), default=4)
     fig.subplots_adjust(left=label / width, right=0.99, top=1 - 0.55 / height,
                         bottom=below / height)
 
@@ -97,6 +109,8 @@ def draw_mission(timeline: dict, header: dict, path: Path) -> Path:
         ax.barh(y, max(stop - w['start'], 0.05), left=w['start'], height=0.3,
                 color=colour[w['job']], **style)
         label = w['job'] + (f"#{w['attempt']}" if w['attempt'] > 1 else '')
+        if not 0 <= (w['start'] + stop) / 2 <= end:
+            continue  # a text far off the axes is more than the renderer can place
         ax.text((w['start'] + stop) / 2, y, label, ha='center', va='center', fontsize=6.5,
                 color='black' if w['outcome'] != 'voided' else 'dimgrey')
     for a in timeline['activities']:
@@ -110,13 +124,15 @@ def draw_mission(timeline: dict, header: dict, path: Path) -> Path:
         if r['time'] is None:
             continue
         x = max(r['time'], 0.0)
+        if x > end:
+            continue
         ax.axvline(x, color='purple', linestyle='--', lw=1)
         ax.text(x, len(robots) - 0.45, f" r{r['number']}", color='purple', fontsize=8,
                 va='bottom')
-    if now_units is not None and not header['ended']:
+    if now_units is not None and not header['ended'] and 0 <= now_units <= end:
         ax.axvline(now_units, color='black', lw=1.2)
         ax.text(now_units, -0.62, ' now', fontsize=8)
-    ax.set_yticks(range(len(robots)), list(reversed(robots)))
+    ax.set_yticks(range(len(robots)), [_cut(r, LABEL) for r in reversed(robots)])
     ax.set_ylim(-0.65, len(robots) - 0.3)
     ax.set_xlim(0, end * 1.02)
     ax.grid(axis='x', alpha=0.25)
@@ -152,6 +168,10 @@ def _title(h: dict) -> str:
             f"{h['jobs_done']}/{h['jobs_total']} jobs done{agree}\nrevision {h['revision']}; "
             f"makespan planned {_n(h['first_makespan'])} (r1), {_n(h['planned_makespan'])} "
             f"(latest), executed {_n(executed)}")
+
+
+def _cut(text: str, length: int) -> str:
+    return text if len(text) <= length else text[:length - 1] + '\u2026'
 
 
 def _n(value) -> str:
