@@ -96,3 +96,25 @@ def test_the_recording_holds_what_verifies_and_its_replay_tells_the_mission_run(
     out = capsys.readouterr().out
     assert 'complete: 12/12 jobs done (planner: 12/12)' in out
     assert '/plan: the recorder dropped 1 message(s) that did not verify' in out
+
+
+@pytest.mark.parametrize(('node', 'key', 'message'), [
+    ('recorder', 'missing', 'cannot read the fleet key'),
+    ('planner_node', 'world-readable', 'readable or writable by others (mode 0644); it must '
+                                       'be private to its owner: chmod 600'),
+    ('monitor_node', 'world-readable', 'readable or writable by others'),
+])
+def test_a_key_file_that_cannot_be_used_stops_the_node_at_start(tmp_path, ros_domain, node,
+                                                                 key, message):
+    path = tmp_path / 'fleet.key'
+    if key == 'world-readable':
+        new_key(path).chmod(0o644)
+    env = dict(os.environ, ROS_DOMAIN_ID=str(ros_domain),
+               ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
+    done = subprocess.run([str(find_executable('fjsp_planner', node)), '--ros-args',
+                           '-p', f'fleet_key_file:={path}', '-p', f'out_dir:={tmp_path}'],
+                          env=env, capture_output=True, text=True, timeout=60)
+    output = done.stdout + done.stderr
+    assert done.returncode == 2, output
+    assert f"parameter 'fleet_key_file': {path}: " in output and message in output
+    assert 'Traceback' not in output

@@ -43,7 +43,8 @@ class FleetKeyError(ValueError):
 
 
 def read_key(path) -> bytes:
-    """The fleet key in `path`: hex text of at least 32 bytes (what `new_key` writes)."""
+    """The fleet key in `path`: hex text of at least 32 bytes (what `new_key` writes), in a
+    file no one but its owner may read or write."""
     path = Path(path).expanduser()
     try:
         text = path.read_text().strip()
@@ -57,6 +58,11 @@ def read_key(path) -> bytes:
     if len(key) < KEY_BYTES:
         raise FleetKeyError(f'{path}: the fleet key has {len(key)} bytes; at least {KEY_BYTES} '
                         'are needed')
+    mode = path.stat().st_mode & 0o777
+    if mode & 0o077:
+        # As ssh refuses a private key others can read: whoever reads it can direct the fleet.
+        raise FleetKeyError(f'{path}: the fleet key is readable or writable by others (mode '
+                            f'{mode:04o}); it must be private to its owner: chmod 600 {path}')
     return key
 
 
