@@ -1,5 +1,5 @@
 """What a fleet does with messages it cannot believe: a malformed plan from anyone in a fleet
-without a key."""
+without a key, and an agent without the key in a fleet with one."""
 
 import copy
 import math
@@ -34,3 +34,23 @@ def test_a_plan_with_a_nan_time_scale_fools_no_one(fjsp_fleet):
     assert observer.status.plan_revision == 1 and observer.status.jobs_done == 12
     for robot in ROBOTS:
         assert 'ignoring a malformed plan revision 50' in fleet.log(f'agent_{robot}')
+
+
+def test_an_agent_without_the_key_is_named_as_unverified(fjsp_fleet):
+    """In a fleet with a key, an agent started without it reports unsigned states: the
+    planner drops them, and says that they do not verify rather than that the robot is
+    silent."""
+    fleet = fjsp_fleet(PAPER, time_scale=0.15, key=True,
+                       planner={'robot_wait_timeout': 5.0})
+    for robot in ROBOTS[:3]:
+        fleet.start_agent(robot)
+    fleet.start_agent('MARC2', fleet_key_file='')
+    fleet.wait_for(lambda o: all(r in o.robots for r in ROBOTS), 60, 'every agent to report')
+    fleet.start_planner()
+    waiting = "waiting for robot 'MARC2' to report: its states do not verify: not signed"
+    fleet.wait_for(lambda o: waiting in o.status.blocked_reasons, 60,
+                   'the planner to say why it does not hear MARC2')
+    unverified = "robot 'MARC2' sends states that do not verify: not signed"
+    fleet.wait_for(lambda o: unverified in o.status.warnings, 60,
+                   'the mission to go on without MARC2, saying why')
+    fleet.wait_for(lambda o: o.complete(), 90, 'the mission to complete without MARC2')

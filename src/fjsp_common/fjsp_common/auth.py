@@ -232,13 +232,18 @@ class NodeAuth:
     def accept(self, msg, name: str, senders=None, service: bool = False) -> bool:
         """Whether `msg` received on `name` verifies; if not, it is counted and warned about
         once per sender and reason."""
+        return not self.refusal(msg, name, senders, service)
+
+    def refusal(self, msg, name: str, senders=None, service: bool = False) -> str:
+        """Why `msg` received on `name` does not verify ('' if it does), counted and warned
+        about once per sender and reason."""
         why = self.verifier.check(msg, self.resolve(name, service), senders)
         if not why:
-            return True
+            return ''
         kind = why.split(':')[0].split("'")[0]
         key = (name, msg.auth.sender[:80], kind)
         if key not in self._warned:
             self._warned.add(key)
             self.node.get_logger().warning(f'dropping an unauthenticated message on {name} '
                                            f'({why}); further ones like it are only counted')
-        return False
+        return why

@@ -568,7 +568,9 @@ class PlannerNode(Node):
         self.carry_out(self.controller.tick(self.wall(), self.plan_pub.get_subscription_count()))
 
     def on_robot_state(self, msg: RobotState) -> None:
-        if not self.auth.accept(msg, ROBOT_STATES_TOPIC, {msg.robot}):
+        why = self.auth.refusal(msg, ROBOT_STATES_TOPIC, {msg.robot})
+        if why:
+            self.controller.unverified_state(msg.robot, why, self.wall())
             return
         mode = MODE_FROM_MSG.get(msg.mode)
         if mode is None:
