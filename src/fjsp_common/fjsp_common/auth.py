@@ -31,6 +31,11 @@ from fjsp_common.fleet import PLANNER_NODE
 from fjsp_common.parameters import ParameterSpec
 
 KEY_BYTES = 32
+MAC_BYTES = 32
+"""An HMAC-SHA256."""
+HMAC_BUDGET = 100
+"""Failed signature checks a second per name and claimed sender (see `Verifier`): a few tens
+of milliseconds of one core."""
 KEY_FILE_VARIABLE = 'FJSP_FLEET_KEY_FILE'
 """Where command-line tools and scripts find the fleet key when not told otherwise."""
 FLEET_KEY_FILE = ParameterSpec('fleet_key_file', '',
@@ -152,12 +157,22 @@ class Signer:
 
 class Verifier:
     """Checks what one process receives; remembers the latest (incarnation, counter) of each
-    sender on each name, so a replayed message is refused."""
+    sender on each name, so a replayed message is refused.
 
-    def __init__(self, key: bytes | None):
+    What costs nothing is checked first — a MAC missing or not 32 bytes long, a sender that
+    may not say this, a counter not above the sender's latest — so a flood of unsigned or
+    stale messages costs no HMAC. A flood of forged signatures does: each name and claimed
+    sender gets HMAC_BUDGET failed checks a second, after which messages claiming that sender
+    are refused unchecked until the second is over. A forger can so silence the sender it
+    impersonates (its messages are refused with the forger's meanwhile), not the process."""
+
+    def __init__(self, key: bytes | None, clock=time.monotonic):
         self.key = key
         self.rejected = 0
         self._latest: dict[tuple[str, str], tuple[int, int]] = {}
+        self._clock = clock
+        self._second = -1
+        self._failed: Counter[tuple[str, str]] = Counter()
 
     def check(self, msg, name: str, senders=None) -> str:
         """Why `msg`, received on resolved `name`, must be dropped ('' if it verifies).
@@ -173,15 +188,26 @@ class Verifier:
         auth = msg.auth
         if not auth.mac:
             return 'not signed'
-        if not hmac.compare_digest(bytes(auth.mac), _digest(self.key, name, msg)):
-            return f"signature of '{auth.sender[:80]}' does not verify with the fleet key"
-        if senders is not None and auth.sender not in senders:
-            return f"'{auth.sender[:80]}' may not send this"
+        sender = auth.sender
+        if len(auth.mac) != MAC_BYTES:
+            return f"a MAC of {len(auth.mac)} bytes from '{sender[:80]}', not {MAC_BYTES}"
+        if senders is not None and sender not in senders:
+            return f"'{sender[:80]}' may not send this"
         stamp = (auth.incarnation, auth.counter)
-        latest = self._latest.get((name, auth.sender))
+        latest = self._latest.get((name, sender))
         if latest is not None and stamp <= latest:
-            return f"replayed message of '{auth.sender[:80]}' (counter {auth.counter})"
-        self._latest[name, auth.sender] = stamp
+            return f"replayed message of '{sender[:80]}' (counter {auth.counter})"
+        second = int(self._clock())
+        if second != self._second:
+            self._second = second
+            self._failed.clear()
+        if self._failed[name, sender] >= HMAC_BUDGET:
+            return (f"more than {HMAC_BUDGET} messages a second of '{sender[:80]}' do not "
+                    'verify: refused unchecked')
+        if not hmac.compare_digest(bytes(auth.mac), _digest(self.key, name, msg)):
+            self._failed[name, sender] += 1
+            return f"signature of '{sender[:80]}' does not verify with the fleet key"
+        self._latest[name, sender] = stamp
         return ''
 
 
