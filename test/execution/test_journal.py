@@ -1,7 +1,10 @@
 """The mission journal: records round-trip exactly, a line cut by a crash is ignored, and
 unfinished missions are found."""
 
+import errno
+import os
 from fractions import Fraction
+from pathlib import Path
 
 import pytest
 
@@ -14,6 +17,7 @@ from fjsp_planner.execution.journal import (
     MissionRecord,
     PlanRecord,
     StartRecord,
+    journal_directory,
     journal_path,
     journals,
     read_journal,
@@ -87,3 +91,46 @@ def test_a_queued_mission_waits_until_its_start_is_journaled(tmp_path):
     assert not waits_in_queue(read_journal(path))
     assert not waits_in_queue([mission('m3', queued=True), EndRecord('cancelled', ('x',))])
     assert not waits_in_queue([mission('m4')])
+
+
+def test_a_record_that_cannot_be_written_leaves_the_journal_as_it_was(tmp_path, monkeypatch):
+    """A disk that fills halfway through a record: the record is cut off again, the error
+    names the file and why, and the journal reads back as it was before."""
+    path = journal_path(tmp_path, 'm1')
+    journal = Journal(path)
+    journal.write(mission())
+    before = path.read_bytes()
+    write = os.write
+
+    def full_after_half(fd, data):
+        write(fd, data[:len(data) // 2])
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    monkeypatch.setattr(os, 'write', full_after_half)
+    with pytest.raises(JournalError, match=f'{path}: cannot write the journal: No space left '
+                                           'on device'):
+        journal.write(PlanRecord(1, 12.5, SCHEDULE, frozenset(), ()))
+    monkeypatch.undo()
+    assert path.read_bytes() == before
+    journal.write(DoneRecord(ASSIGNMENT, 1))
+    journal.close()
+    assert read_journal(path) == [mission(), DoneRecord(ASSIGNMENT, 1)]
+
+
+def test_a_full_device_is_a_journal_error_not_an_os_error():
+    journal = Journal(Path('/dev/full'))
+    with pytest.raises(JournalError, match='/dev/full: cannot write the journal: No space'):
+        journal.write(mission())
+    journal.close()
+
+
+def test_a_journal_directory_that_cannot_be_one_is_named(tmp_path):
+    file = tmp_path / 'file'
+    file.write_text('')
+    with pytest.raises(JournalError, match=f'{file}: is not a directory'):
+        journal_directory(file)
+    with pytest.raises(JournalError, match=f'{file / "sub"}: cannot be made: Not a directory'):
+        journal_directory(file / 'sub')
+    with pytest.raises(JournalError, match='/proc: cannot create files in it'):
+        journal_directory('/proc')
+    assert journal_directory(tmp_path / 'new' / 'dir').is_dir()

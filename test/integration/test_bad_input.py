@@ -37,7 +37,7 @@ from repo_paths import PAPER
     (['run', 'fjsp_planner', 'fleet', 'truss', '--time-scale', 'fast'], 2,
      "argument --time-scale: expected a number > 0, got 'fast'"),
     (['run', 'fjsp_planner', 'fleet', 'truss', '--params-file', '/no/such.yaml'], 2,
-     '/no/such.yaml: cannot read parameters file: No such file or directory'),
+     '/no/such.yaml: no such file'),
     (['run', 'fjsp_planner', 'fleet', 'truss', '--web-port', '65536'], 2,
      'argument --web-port: must be within [0, 65535], got 65536'),
     (['run', 'fjsp_planner', 'fleet', 'truss', '--web-port', 'http'], 2,

@@ -7,7 +7,9 @@ Free of ROS, so the domain core and tools use them too:
 - `clock`: one mission's schedule clock, wall seconds <-> schedule units;
 - `revisions`: which attempt at a job a report is about, and whether it still counts;
 - `parameters`: a node parameter's one definition (`ParameterSpec`);
-- `decimals`: how every time a person reads is written (decimals, never raw fractions).
+- `decimals`: how every time a person reads is written (decimals, never raw fractions);
+- `wellformed`: what a plan or event must hold to be acted on (times that are numbers, a
+  usable time scale), checked by every reader.
 
 With ROS:
 

@@ -11,6 +11,9 @@ but the planner publishing plans or job completions), or a counter that does not
 (a replay).
 
 Without a key nothing is signed or checked, and every node says so when it starts.
+
+The key files and the checking need no ROS (a recording is checked by `replay` on a machine
+without it); signing, and a node's parameter, import it when used.
 """
 
 import hashlib
@@ -24,9 +27,8 @@ import time
 from collections import Counter
 from pathlib import Path
 
+from fjsp_common.fleet import PLANNER_NODE
 from fjsp_common.parameters import ParameterSpec
-from fjsp_common.running import ParameterError, declare, shorten
-from fjsp_msgs.msg import Auth
 
 KEY_BYTES = 32
 CLIENT_ID_BYTES = 4
@@ -35,6 +37,11 @@ SENDERS_KEPT = 4096
 """Senders a receiver remembers the latest message of, per topic or service; beyond them, the
 least recently heard is forgotten. Clients sign under names of their own, so a long-running
 planner hears a new sender at every command a user types."""
+MAC_BYTES = 32
+"""An HMAC-SHA256."""
+HMAC_BUDGET = 100
+"""Failed signature checks a second per name and claimed sender (see `Verifier`): a few tens
+of milliseconds of one core."""
 KEY_FILE_VARIABLE = 'FJSP_FLEET_KEY_FILE'
 """Where command-line tools and scripts find the fleet key when not told otherwise."""
 FLEET_KEY_FILE = ParameterSpec('fleet_key_file', '',
@@ -47,7 +54,8 @@ class FleetKeyError(ValueError):
 
 
 def read_key(path) -> bytes:
-    """The fleet key in `path`: hex text of at least 32 bytes (what `new_key` writes)."""
+    """The fleet key in `path`: hex text of at least 32 bytes (what `new_key` writes), in a
+    file no one but its owner may read or write."""
     path = Path(path).expanduser()
     try:
         text = path.read_text().strip()
@@ -61,6 +69,11 @@ def read_key(path) -> bytes:
     if len(key) < KEY_BYTES:
         raise FleetKeyError(f'{path}: the fleet key has {len(key)} bytes; at least {KEY_BYTES} '
                         'are needed')
+    mode = path.stat().st_mode & 0o777
+    if mode & 0o077:
+        # As ssh refuses a private key others can read: whoever reads it can direct the fleet.
+        raise FleetKeyError(f'{path}: the fleet key is readable or writable by others (mode '
+                            f'{mode:04o}); it must be private to its owner: chmod 600 {path}')
     return key
 
 
@@ -87,9 +100,12 @@ def _digest(key: bytes, name: str, msg) -> bytes:
 def _canonical(value):
     """The message's content, field by field in definition order, floats exact. Not its CDR
     serialization: that carries whatever happened to be in memory in its padding bytes, so
-    the same message serializes differently from one call to the next."""
+    the same message serializes differently from one call to the next. A message decoded
+    from a recording (`mcap_ros2`) lists its fields in `__slots__`, in the same order."""
     if hasattr(value, 'get_fields_and_field_types'):
         return [_canonical(getattr(value, field)) for field in value.get_fields_and_field_types()]
+    if hasattr(value, '__slots__') and hasattr(value, '__dict__'):
+        return [_canonical(getattr(value, field)) for field in value.__slots__]
     if isinstance(value, bool | str):
         return value
     if isinstance(value, numbers.Integral):
@@ -99,6 +115,20 @@ def _canonical(value):
     if isinstance(value, bytes):
         return value.hex()
     return [_canonical(item) for item in value]
+
+
+def signers_of(msg, job_done: bool | None = None) -> frozenset[str]:
+    """Who may sign `msg` (a live message, or one decoded from a recording): the robot a
+    robot state, or a robot's task event, is about; the planner for everything else (plans,
+    job completions, mission events, statuses, job states). `job_done` says whether a task
+    event declares a job done; by default the message's class constant tells (a live message
+    has it, one decoded from a recording does not)."""
+    kind = type(msg).__name__
+    if kind == 'TaskEvent' and job_done is None:
+        job_done = msg.kind == getattr(type(msg), 'KIND_JOB_DONE', None)
+    if kind == 'RobotState' or (kind == 'TaskEvent' and not job_done):
+        return frozenset({msg.robot})
+    return frozenset({PLANNER_NODE})
 
 
 def client_signer(key_file, role: str) -> 'Signer':
@@ -125,6 +155,8 @@ class Signer:
     def sign(self, msg, name: str):
         """`msg` with its `auth` filled for resolved topic or service `name`. Without a key
         it names its sender all the same (receivers tell senders apart by it), unsigned."""
+        from fjsp_msgs.msg import Auth
+
         self._counters[name] += 1
         msg.auth = Auth(sender=self.sender, incarnation=self.incarnation,
                         counter=self._counters[name], mac=[])
@@ -135,12 +167,22 @@ class Signer:
 
 class Verifier:
     """Checks what one process receives; remembers the latest (incarnation, counter) of each
-    sender on each name, so a replayed message is refused."""
+    sender on each name, so a replayed message is refused.
 
-    def __init__(self, key: bytes | None):
+    What costs nothing is checked first — a MAC missing or not 32 bytes long, a sender that
+    may not say this, a counter not above the sender's latest — so a flood of unsigned or
+    stale messages costs no HMAC. A flood of forged signatures does: each name and claimed
+    sender gets HMAC_BUDGET failed checks a second, after which messages claiming that sender
+    are refused unchecked until the second is over. A forger can so silence the sender it
+    impersonates (its messages are refused with the forger's meanwhile), not the process."""
+
+    def __init__(self, key: bytes | None, clock=time.monotonic):
         self.key = key
         self.rejected = 0
         self._latest: dict[tuple[str, str], tuple[int, int]] = {}
+        self._clock = clock
+        self._second = -1
+        self._failed: Counter[tuple[str, str]] = Counter()
 
     def check(self, msg, name: str, senders=None) -> str:
         """Why `msg`, received on resolved `name`, must be dropped ('' if it verifies).
@@ -156,16 +198,27 @@ class Verifier:
         auth = msg.auth
         if not auth.mac:
             return 'not signed'
-        if not hmac.compare_digest(bytes(auth.mac), _digest(self.key, name, msg)):
-            return f"signature of '{auth.sender[:80]}' does not verify with the fleet key"
-        if senders is not None and auth.sender not in senders:
-            return f"'{auth.sender[:80]}' may not send this"
+        sender = auth.sender
+        if len(auth.mac) != MAC_BYTES:
+            return f"a MAC of {len(auth.mac)} bytes from '{sender[:80]}', not {MAC_BYTES}"
+        if senders is not None and sender not in senders:
+            return f"'{sender[:80]}' may not send this"
         stamp = (auth.incarnation, auth.counter)
-        latest = self._latest.pop((name, auth.sender), None)
+        latest = self._latest.get((name, sender))
         if latest is not None and stamp <= latest:
-            self._latest[name, auth.sender] = latest
-            return f"replayed message of '{auth.sender[:80]}' (counter {auth.counter})"
-        self._latest[name, auth.sender] = stamp
+            return f"replayed message of '{sender[:80]}' (counter {auth.counter})"
+        second = int(self._clock())
+        if second != self._second:
+            self._second = second
+            self._failed.clear()
+        if self._failed[name, sender] >= HMAC_BUDGET:
+            return (f"more than {HMAC_BUDGET} messages a second of '{sender[:80]}' do not "
+                    'verify: refused unchecked')
+        if not hmac.compare_digest(bytes(auth.mac), _digest(self.key, name, msg)):
+            self._failed[name, sender] += 1
+            return f"signature of '{sender[:80]}' does not verify with the fleet key"
+        self._latest.pop((name, sender), None)  # re-inserted: the most recently heard last
+        self._latest[name, sender] = stamp
         if len(self._latest) > SENDERS_KEPT:
             del self._latest[next(iter(self._latest))]
         return ''
@@ -176,6 +229,8 @@ class NodeAuth:
     the node resolves them, and one warning per sender and reason for what is dropped."""
 
     def __init__(self, node, sender: str):
+        from fjsp_common.running import ParameterError, declare
+
         self.node = node
         path = declare(node, FLEET_KEY_FILE)
         key = None
@@ -219,13 +274,13 @@ class NodeAuth:
         return not self.refusal(msg, name, senders, service)
 
     def refusal(self, msg, name: str, senders=None, service: bool = False) -> str:
-        """Why `msg` received on `name` does not verify ('' if it does), for an answer to
-        its sender: counted and warned about as by `accept`."""
+        """Why `msg` received on `name` does not verify ('' if it does), counted and warned
+        about once per sender and reason."""
         why = self.verifier.check(msg, self.resolve(name, service), senders)
         if not why:
             return ''
         kind = why.split(':')[0].split("'")[0]
-        key = (name, shorten(msg.auth.sender, 80), kind)
+        key = (name, msg.auth.sender[:80], kind)
         if key not in self._warned:
             self._warned.add(key)
             self.node.get_logger().warning(f'dropping an unauthenticated message on {name} '

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import PoseArray
+from rclpy.exceptions import InvalidHandle
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 from visualization_msgs.msg import MarkerArray
 
@@ -110,9 +111,39 @@ def publisher(node, topic: Topic):
     return node.create_publisher(topic.type, topic.name, topic.writer_qos or topic.qos)
 
 
+DRAIN = 1000
+"""Messages a subscription's callback takes in a row once one came, before the executor serves
+the node's other callbacks."""
+
+
 def subscription(node, topic: Topic, callback, **options):
-    """A subscription of `node` to `topic`, with the QoS its readers use."""
-    return node.create_subscription(topic.type, topic.name, callback, topic.qos, **options)
+    """A subscription of `node` to `topic`, with the QoS its readers use, that takes every
+    message waiting (up to DRAIN) each time the executor serves it.
+
+    rclpy's executor rebuilds its wait set for every message it hands over, which limits a
+    node to a few hundred messages a second; all writers of a topic share one reader history
+    (KEEP_LAST), so a flood beyond that rate — forged messages, dropped at once by the
+    callback — would push the fleet's own messages out of the history before they are taken
+    (robots' heartbeats lost: robots declared offline). Taken in a row, messages cost only
+    their callback."""
+    taking = []
+
+    def take_all(msg) -> None:
+        callback(msg)
+        sub = taking[0]
+        for _ in range(DRAIN):
+            try:
+                with sub.handle:
+                    taken = sub.handle.take_message(sub.msg_type, sub.raw)
+            except InvalidHandle:
+                return  # destroyed by the callback
+            if taken is None:
+                return
+            callback(taken[0])
+
+    sub = node.create_subscription(topic.type, topic.name, take_all, topic.qos, **options)
+    taking.append(sub)
+    return sub
 
 
 def _pair(vocabulary, message, prefix: str) -> tuple[dict, dict]:

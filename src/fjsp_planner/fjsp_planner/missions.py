@@ -30,10 +30,12 @@ import sys
 import threading
 import time
 import uuid
+from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
 
 from fjsp_common.decimals import decimal, decimals
+from fjsp_common.fleet import PLANNER_NODE
 
 RESEND = 1.0
 """Seconds without an answer after which a request is sent again."""
@@ -155,7 +157,7 @@ class MissionClient:
         from rclpy.action import ActionClient
         from rclpy.executors import SingleThreadedExecutor
 
-        from fjsp_common.auth import FleetKeyError, client_signer
+        from fjsp_common.auth import FleetKeyError, Verifier, client_signer
         from fjsp_common.contract import (
             ADD_JOBS_SERVICE,
             CANCEL_MISSION_SERVICE,
@@ -184,6 +186,10 @@ class MissionClient:
         self._cancel = self._node.create_client(CancelMission, CANCEL_MISSION_SERVICE)
         self._status = None
         self._status_seen = threading.Event()
+        self._verifier = Verifier(self._signer.key)
+        self._status_topic = self._node.resolve_topic_name(MISSION_STATUS_TOPIC)
+        self.statuses_dropped: Counter[str] = Counter()
+        """Mission statuses that do not verify with the fleet key, by reason: never shown."""
         self._node.create_subscription(MissionStatus, MISSION_STATUS_TOPIC, self._on_status,
                                        LATCHED_QOS)
         self._executor = SingleThreadedExecutor(context=self._context)
@@ -200,6 +206,10 @@ class MissionClient:
                     raise
 
     def _on_status(self, msg):
+        why = self._verifier.check(msg, self._status_topic, {PLANNER_NODE})
+        if why:
+            self.statuses_dropped[why] += 1
+            return
         self._status = msg
         self._status_seen.set()
 
@@ -359,11 +369,24 @@ class MissionClient:
         return status.mission_id
 
     def status(self, timeout: float = 10.0):
-        """The latest MissionStatus (latched: it comes as soon as the planner is found)."""
+        """The latest MissionStatus that verifies with the fleet key, if the client has one
+        (latched: it comes as soon as the planner is found). Those that do not verify are
+        counted in `statuses_dropped`, never returned."""
         if not self._status_seen.wait(timeout):
-            raise MissionError(f'no mission status within {timeout:g} s: is the planner '
-                               'running, with the same ROS_DOMAIN_ID?')
+            dropped = self.dropped_statuses()
+            raise MissionError(f'no mission status within {timeout:g} s'
+                               + (f' ({dropped})' if dropped else '')
+                               + ': is the planner running, with the same ROS_DOMAIN_ID and '
+                               'fleet key?')
         return self._status
+
+    def dropped_statuses(self) -> str:
+        """How many mission statuses were dropped as not verifying, and why ('' if none)."""
+        if not self.statuses_dropped:
+            return ''
+        return (f'ignored {self.statuses_dropped.total()} mission status message(s) that do '
+                'not verify with the fleet key: ' + '; '.join(
+                    f'{n} {why}' for why, n in self.statuses_dropped.most_common(3)))
 
     def _call(self, client, request, timeout):
         """The planner's answer. The request is resent every RESEND seconds until answered
@@ -514,6 +537,8 @@ def _run(client: MissionClient, args) -> int:
     from fjsp_common.vocabulary import MissionState
 
     status = client.status(args.timeout)
+    if client.statuses_dropped:
+        print(f'mission: {client.dropped_statuses()}', file=sys.stderr)
     state = STATE_FROM_MSG.get(status.state, f'state {status.state}')
     if state == MissionState.IDLE:
         print('idle: no mission yet, the planner waits for one')

@@ -53,6 +53,7 @@ from fjsp_common.parameters import ParameterSpec, table
 from fjsp_common.revisions import plan_attempts
 from fjsp_common.running import ParameterError, declare, run_node, shorten
 from fjsp_common.vocabulary import EventKind, RobotMode
+from fjsp_common.wellformed import plan_problem
 from fjsp_msgs.msg import Plan, RobotState, TaskEvent
 from fjsp_msgs.srv import InjectFault
 from robot_agents.action_driver import (
@@ -140,6 +141,7 @@ class RobotAgent(Node):
         self.robot_type = self.pinned_type
         self.refusal = ''
         """Why the latest plan received is not followed ('' when it is)."""
+        self.malformed_plans = 0
         self.last_state = None
         self.answered: dict[str, tuple[bool, str]] = {}
         """The latest fault requests' answers by request id, for callers that resend."""
@@ -193,6 +195,15 @@ class RobotAgent(Node):
             return
         log = self.get_logger()
         mission = shorten(msg.mission_id, 80)
+        malformed = plan_problem(msg)
+        if malformed:
+            # Not a refusal: the fleet's planner never sends one, so the robot's state stays
+            # what its own planner expects.
+            if not self.malformed_plans:
+                log.warning(f"ignoring a malformed plan revision {msg.revision} of mission "
+                            f"'{mission}': {malformed}; further ones are only counted")
+            self.malformed_plans += 1
+            return
         new_mission = msg.mission_id != self.mission_id
         if new_mission and self.clock is not None \
                 and seconds(msg.mission_start) <= self.clock.mission_start:
@@ -253,8 +264,6 @@ class RobotAgent(Node):
     def refusal_of(self, msg: Plan) -> str:
         """Why this agent cannot follow `msg`, or '' if it can."""
         where = f"plan revision {msg.revision} of mission '{shorten(msg.mission_id, 80)}'"
-        if not msg.time_scale > 0 or msg.time_scale == float('inf'):
-            return f'{where} has time_scale {msg.time_scale}; ignoring the plan'
         mine = [r for r in msg.robots if r.robot == self.robot]
         if not mine:
             if msg.cancelled:

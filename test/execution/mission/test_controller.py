@@ -1237,3 +1237,25 @@ def test_a_planner_that_stands_down_fails_its_missions_and_publishes_no_plan(pro
                                                    ('another planner is in charge',))]
     assert fleet.state() == MissionState.FAILED and not fleet.controller.busy
     assert fleet.status().blocked == ('another planner is in charge',)
+
+
+def test_a_robot_whose_states_do_not_verify_is_named_so_not_merely_silent(problem):
+    """An agent started without the fleet key: its states are dropped, so it is never heard,
+    and the mission says why rather than only that it has not reported or went offline."""
+    fleet = Fleet(problem)
+    fleet.start()
+    fleet.controller.unverified_state('MARC2', 'not signed', fleet.wall)
+    fleet.controller.unverified_state('nobody', 'not signed', fleet.wall)
+    assert fleet.status().blocked[-1] == ("waiting for robot 'MARC2' to report: its states do "
+                                          'not verify: not signed')
+    assert 'nobody' not in fleet.controller.liveness.unverified
+    fleet = executing(problem)
+    for _ in range(15):
+        fleet.controller.unverified_state('MARC2', 'not signed', fleet.wall)
+        fleet.tick(robots=ROBOTS[:3])
+    (offline,) = notes(fleet.effects, MissionEventKind.ROBOT_OFFLINE)
+    assert offline.robot == 'MARC2'
+    assert offline.reasons[0].startswith('no state that verifies for 1.')
+    assert offline.reasons[0].endswith('s: not signed')
+    assert "robot 'MARC2' sends states that do not verify: not signed" in \
+        kinds(fleet.effects, Solve)[-1].reasons

@@ -5,11 +5,13 @@ revisions (which robots do which job, which jobs a revision continued) and the p
 verdicts (a job done, jobs added, the mission's end) die with the planner. The journal keeps
 them: one file per mission, one JSON object per line, appended and flushed to disk before the
 planner acts on what it records (a plan is on disk before any robot can follow it). A line cut
-short by a crash is ignored, as is anything after it.
+short by a crash is ignored, as is anything after it. A record that cannot be written leaves
+the file as it was before it (`JournalError`).
 """
 
 import json
 import os
+import tempfile
 from dataclasses import dataclass, field
 from fractions import Fraction
 from pathlib import Path
@@ -96,26 +98,83 @@ def waits_in_queue(records: list[Record]) -> bool:
 
 class Journal:
     """Appends records to one mission's file; `write(..., sync=True)` returns once they
-    are on disk."""
+    are on disk.
+
+    A record that cannot be written whole (a full disk, a file size limit, a directory made
+    read-only) is cut off again, so the file keeps every record before it and nothing of it,
+    and `JournalError` says why: the caller decides what a mission without its journal
+    does. Records are written with one system call each, not through a buffer that would
+    try a failed write again when the next record comes."""
 
     def __init__(self, path: Path):
         self.path = Path(path)
-        self.path.parent.mkdir(parents=True, exist_ok=True)
-        self._file = self.path.open('a', encoding='utf-8')
+        try:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+            self._fd = os.open(self.path, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o644)
+        except OSError as error:
+            raise JournalError(f'{self.path}: cannot open the journal: '
+                               f'{error.strerror or error}') from None
 
     def write(self, record: Record, sync: bool = True) -> None:
-        self._file.write(json.dumps(_encode(record), separators=(',', ':')) + '\n')
-        if sync:
-            self.sync()
+        data = (json.dumps(_encode(record), separators=(',', ':')) + '\n').encode()
+        try:
+            size = os.fstat(self._fd).st_size
+        except OSError as error:
+            raise JournalError(self._failed(error)) from None
+        try:
+            written = 0
+            while written < len(data):
+                written += os.write(self._fd, data[written:])
+            if sync:
+                os.fsync(self._fd)
+        except OSError as error:
+            try:
+                os.ftruncate(self._fd, size)
+            except OSError:
+                pass  # a line cut short is ignored when read
+            raise JournalError(self._failed(error)) from None
 
     def sync(self) -> None:
-        self._file.flush()
-        os.fsync(self._file.fileno())
+        try:
+            os.fsync(self._fd)
+        except OSError as error:
+            raise JournalError(self._failed(error)) from None
+
+    def _failed(self, error: OSError) -> str:
+        return f'{self.path}: cannot write the journal: {error.strerror or error}'
 
     def close(self) -> None:
-        if not self._file.closed:
-            self.sync()
-            self._file.close()
+        """Close the file; what was written with `sync` is on disk already."""
+        if self._fd >= 0:
+            fd, self._fd = self._fd, -1
+            try:
+                os.close(fd)
+            except OSError:
+                pass
+
+    def discard(self) -> None:
+        """Close and delete the file: the mission it was opened for does not run."""
+        self.close()
+        self.path.unlink(missing_ok=True)
+
+
+def journal_directory(path) -> Path:
+    """`path`, made if missing, as a directory journals can be created in; JournalError
+    saying why it cannot be one."""
+    path = Path(path).expanduser()
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except FileExistsError:
+        raise JournalError(f'{path}: is not a directory') from None
+    except OSError as error:
+        raise JournalError(f'{path}: cannot be made: {error.strerror or error}') from None
+    try:
+        with tempfile.TemporaryFile(dir=path):
+            pass
+    except OSError as error:
+        raise JournalError(f'{path}: cannot create files in it: {error.strerror or error}'
+                           ) from None
+    return path
 
 
 def journal_path(directory: Path, mission_id: str) -> Path:

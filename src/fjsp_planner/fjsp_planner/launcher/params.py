@@ -7,18 +7,17 @@ from pathlib import Path
 
 import yaml
 
+from fjsp_planner.model.bounded_yaml import load_yaml
+from fjsp_planner.model.limits import read_input_file
+from fjsp_planner.model.problem import ProblemError
+
 
 def read_params_file(path: Path) -> tuple[dict, list[str]]:
     """The parameters file's sections, and what makes it unusable (empty if nothing)."""
     try:
-        data = yaml.safe_load(path.read_text())
-    except OSError as error:
-        return {}, [f'{path}: cannot read parameters file: {error.strerror}']
-    except yaml.YAMLError as error:
-        mark = getattr(error, 'problem_mark', None)
-        where = f'line {mark.line + 1}, column {mark.column + 1}' if mark else 'unknown place'
-        return {}, [f'{path}: YAML syntax error at {where}: '
-                    f"{getattr(error, 'problem', None) or error}"]
+        data = load_yaml(read_input_file(path, 'parameters'))
+    except ProblemError as error:
+        return {}, [p if p.startswith(f'{path}:') else f'{path}: {p}' for p in error.problems]
     if not isinstance(data, dict) or not list(_sections(data)):
         return {}, [f'{path}: not a ROS parameters file (expected sections like '
                     "'/**: {ros__parameters: {...}}' or '<node name>: {ros__parameters: ...}')"]

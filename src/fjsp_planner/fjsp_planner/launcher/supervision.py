@@ -274,9 +274,12 @@ class Fleet:
                                {**own, **self.extra[MONITOR_NODE], **params}, stream=stream)
 
     def start_recorder(self, **params) -> subprocess.Popen:
-        """The flight recorder: every mission topic into `<out>/fjsp_<time>.mcap`."""
-        return self.start_node(RECORDER_NODE, 'fjsp_planner', 'recorder',
-                               {'out_dir': self.out, **params})
+        """The flight recorder: every mission topic into `<out>/fjsp_<time>.mcap` (what
+        verifies with the fleet's key, if it has one)."""
+        own = {'out_dir': self.out}
+        if self.key_file is not None:
+            own['fleet_key_file'] = self.key_file
+        return self.start_node(RECORDER_NODE, 'fjsp_planner', 'recorder', {**own, **params})
 
     def start_node(self, name: str, package: str, executable: str, params=None,
                    ros_args=(), stream: bool = False, prefix=None) -> subprocess.Popen:

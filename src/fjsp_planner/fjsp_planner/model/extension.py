@@ -11,8 +11,8 @@ so such arcs are refused too.
 
 from collections.abc import Collection
 
-import yaml
-
+from fjsp_planner.model.bounded_yaml import load_yaml
+from fjsp_planner.model.limits import shown
 from fjsp_planner.model.problem import Problem, ProblemError
 from fjsp_planner.model.scenario import parse_scenario, problem_mapping
 
@@ -24,12 +24,9 @@ def extend(problem: Problem, fragment: str, started: Collection[str] = ()
     """`problem` with the fragment's jobs, and their names; ProblemError lists every reason
     the fragment cannot be added. `started` names the jobs that have started or are done."""
     try:
-        data = yaml.safe_load(fragment)
-    except yaml.YAMLError as error:
-        mark = getattr(error, 'problem_mark', None)
-        where = f'line {mark.line + 1}, column {mark.column + 1}' if mark else 'unknown place'
-        raise ProblemError([f'fragment: YAML syntax error at {where}: '
-                            f"{getattr(error, 'problem', None) or error}"]) from None
+        data = load_yaml(fragment)
+    except ProblemError as error:
+        raise ProblemError([f'fragment: {p}' for p in error.problems]) from None
     if not isinstance(data, dict):
         raise ProblemError(['fragment: must be a mapping with a `jobs` section'])
     problems = [f"fragment: unknown section '{key}' (a fragment has {', '.join(SECTIONS)})"
@@ -46,10 +43,10 @@ def extend(problem: Problem, fragment: str, started: Collection[str] = ()
         for arc in arcs if isinstance(arcs, list) else ():
             if isinstance(arc, list) and len(arc) >= 2 and str(arc[1]) in existing \
                     and str(arc[1]) in started:
-                problems.append(f'{key} arc {arc!r}: job {str(arc[1])!r} has already started')
+                problems.append(f'{key} arc {shown(arc)}: job {str(arc[1])!r} has already started')
             if key == 'holding' and isinstance(arc, list) and len(arc) >= 2 \
                     and str(arc[0]) in existing and str(arc[0]) in started:
-                problems.append(f'holding arc {arc!r}: job {str(arc[0])!r} has already '
+                problems.append(f'holding arc {shown(arc)}: job {str(arc[0])!r} has already '
                                 'started, so its robots cannot be told to hold')
     merged = problem_mapping(problem)
     merged['jobs'] = merged['jobs'] + jobs

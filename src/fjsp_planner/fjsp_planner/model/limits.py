@@ -42,6 +42,12 @@ MAX_ARCS = 10_000
 """Precedence arcs, holding arcs, time overrides: each list."""
 MAX_NAME_LENGTH = 100
 MAX_FILE_BYTES = 4 * 2**20
+MAX_NESTING = 64
+"""Levels of YAML collections inside one another: a scenario needs six, a parameters file
+a few more per namespace; a YAML parser that recurses crashes on thousands."""
+MAX_YAML_VALUES = 2_000_000
+"""Values of one YAML text, each alias counted as what it names: a full distance table of
+1100 names is 1.2 million."""
 MAX_WORKERS = 64
 """More search workers than this only thrash on any machine the fleet's planner runs on, and
 CP-SAT rejects absurd counts with an opaque "model invalid"."""

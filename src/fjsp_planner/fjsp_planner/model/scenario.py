@@ -11,18 +11,14 @@ rather than once more by every arc that names it.
 from fractions import Fraction
 from pathlib import Path
 
-import yaml
-
 from fjsp_common.decimals import decimals
 from fjsp_planner.model import limits
+from fjsp_planner.model.bounded_yaml import load_yaml
 from fjsp_planner.model.limits import MAX_COORDINATE, MAX_TIME, shown
 from fjsp_planner.model.places import euclidean_distances, on_grid, panel_coordinates
 from fjsp_planner.model.problem import Job, Problem, ProblemError, Robot, listed, suggestion
 
 DEFAULT_SHIFT = Fraction(60)
-
-# The C parser is about five times faster on a large distance table.
-_LOADER = getattr(yaml, 'CSafeLoader', yaml.SafeLoader)
 
 SECTIONS = ('name', 'operation_types', 'locomote', 'robot_types', 'robots', 'jobs',
             'locations', 'distances', 'precedence', 'holding', 'time_overrides', 'panels')
@@ -59,10 +55,6 @@ def scenario_from_text(text: str, name: str = 'mission', panels: int | None = No
     files; `name` names it when the text has no `name` of its own."""
     try:
         shift = _checked_overrides(panels, shift)
-        size = len(text.encode(errors='replace'))
-        if size > limits.MAX_FILE_BYTES:
-            raise ProblemError([f'the scenario text has {size} bytes; at most '
-                                f'{limits.MAX_FILE_BYTES} are read'])
         return _from_text(text, name, panels, shift)
     except ProblemError as error:
         raise ScenarioError(error.problems) from None
@@ -87,26 +79,11 @@ def _checked_overrides(panels, shift) -> Fraction | None:
 
 
 def _from_text(text: str, name: str, panels, shift) -> Problem:
-    problem, file_panels = _from_mapping(_parse_yaml(text), default_name=name, panels=panels,
+    problem, file_panels = _from_mapping(load_yaml(text), default_name=name, panels=panels,
                                          shift=shift)
     count = panels if panels is not None else file_panels['count']
     distance = shift if shift is not None else file_panels['shift']
     return repeat_panels(problem, count, distance)
-
-
-def _parse_yaml(text: str):
-    try:
-        return yaml.load(text, Loader=_LOADER)  # noqa: S506 - a safe loader
-    except yaml.YAMLError as error:
-        mark = getattr(error, 'problem_mark', None)
-        where = f'line {mark.line + 1}, column {mark.column + 1}' if mark else 'unknown place'
-        reason = getattr(error, 'problem', None) or str(error)
-        raise ProblemError([f'YAML syntax error at {where}: {reason}']) from None
-    except (ValueError, OverflowError) as error:
-        # e.g. an integer of more than 4300 digits, or a date that does not exist
-        raise ProblemError([f'YAML value that cannot be read: {shown(str(error))}']) from None
-    except RecursionError:
-        raise ProblemError(['YAML nested too deeply']) from None
 
 
 def parse_scenario(data, name='scenario') -> Problem:

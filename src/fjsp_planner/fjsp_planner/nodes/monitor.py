@@ -20,7 +20,7 @@ from pathlib import Path
 from rclpy.node import Node
 from std_msgs.msg import Header
 
-from fjsp_common.auth import NodeAuth
+from fjsp_common.auth import NodeAuth, signers_of
 from fjsp_common.contract import (
     DIAGNOSTICS,
     FLEET_MAP,
@@ -39,7 +39,6 @@ from fjsp_common.fleet import (
     HEARTBEAT_TIMEOUT,
     LATE_THRESHOLD,
     MONITOR_NODE,
-    PLANNER_NODE,
 )
 from fjsp_common.parameters import ParameterSpec, table
 from fjsp_common.running import declare, run_node, shorten
@@ -84,15 +83,6 @@ PARAMETERS = table(
                   'map, to publish their poses', low=0.02, high=60.0),
 )
 """The monitor's parameters, in the order it declares them."""
-
-
-def senders_of(msg) -> set[str]:
-    """Who may have signed `msg`: the robot it is about, or the planner."""
-    if isinstance(msg, RobotState):
-        return {msg.robot}
-    if isinstance(msg, TaskEvent) and msg.kind != TaskEvent.KIND_JOB_DONE:
-        return {msg.robot}
-    return {PLANNER_NODE}
 
 
 class MonitorNode(Node):
@@ -143,7 +133,7 @@ class MonitorNode(Node):
 
     def receiver(self, type_name: str, topic: str):
         def receive(msg) -> None:
-            if not self.auth.accept(msg, topic, senders_of(msg)):
+            if not self.auth.accept(msg, topic, signers_of(msg)):
                 return
             try:
                 fact = DECODER.read(type_name, msg)

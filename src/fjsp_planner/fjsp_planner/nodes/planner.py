@@ -68,9 +68,11 @@ from fjsp_planner.execution.journal import (
     EndRecord,
     JobsAddedRecord,
     Journal,
+    JournalError,
     MissionRecord,
     PlanRecord,
     StartRecord,
+    journal_directory,
     journal_path,
     journals,
     waits_in_queue,
@@ -104,6 +106,9 @@ WITHDRAW_GRACE = 1.0
 results."""
 
 SOLVER_NICENESS = 10
+
+JOURNAL_RETRY = 5.0
+"""Seconds between attempts to resume a mission whose journal could not be written."""
 
 
 def yield_to_the_fleet() -> None:
@@ -179,7 +184,12 @@ class PlannerNode(Node):
         self.solver = value['solver']
         self.time_scale, self.start_delay = value['time_scale'], value['start_delay']
         status_period, journal_dir = value['status_period'], value['journal_dir']
-        self.journal_dir = Path(journal_dir).expanduser() if journal_dir else None
+        self.journal_dir = None
+        if journal_dir:
+            try:
+                self.journal_dir = journal_directory(journal_dir)
+            except JournalError as error:
+                raise ParameterError(f"parameter 'journal_dir': {error}") from None
         self.startup = None
         """The `scenario` parameter's mission, started once this planner takes charge:
         (problem, text, file, panels, shift, origin)."""
@@ -200,6 +210,9 @@ class PlannerNode(Node):
         self.journal: Journal | None = None
         self.goals: dict[str, Goal] = {}
         """The RunMission goals of missions running or queued, by mission id."""
+        self.journal_blocked: tuple[str, str, float] | None = None
+        """(mission, why, when) of a mission set aside because its journal could not be
+        written: resumed from the journal once it can be."""
         self.job_done_ids: set[str] = set()
         self.solver_answer: tuple[str, float | None] = ('', None)
         """Status and gap of the latest plan's solve."""
@@ -279,8 +292,11 @@ class PlannerNode(Node):
         else:
             log.info(f"scenario '{problem.name}' from {scenario}: {len(problem.jobs)} jobs, "
                      'robots ' + ', '.join(r.name for r in problem.robots))
-            self.submit_mission(problem, text, problem.name, panels, shift, origin,
-                                self.settings())
+            try:
+                self.submit_mission(problem, text, problem.name, panels, shift, origin,
+                                    self.settings())
+            except (JournalError, ValueError) as error:
+                log.error(f"cannot start '{scenario}': {error}")
 
     # --- who is in charge ------------------------------------------------------------------
 
@@ -354,16 +370,31 @@ class PlannerNode(Node):
 
     def submit_mission(self, problem, text, name, panels, shift, origin, settings,
                        queue: bool = True) -> tuple[str, int]:
-        """Start a mission, or queue it behind the running one unless `queue` is False
-        (ValueError saying why if it cannot be taken); its id and place in the queue (0:
-        started)."""
+        """Start a mission, or queue it behind the running one unless `queue` is False; its
+        id and place in the queue (0: started). ValueError saying why if it cannot be taken,
+        JournalError if its journal cannot be written: it is refused before it is taken."""
+        if self.journal_blocked is not None:
+            raise ValueError(f"mission '{self.journal_blocked[0]}' is set aside until its "
+                             'journal can be written: no mission is taken meanwhile')
         mission_id = new_mission_id(problem.name)
-        position, effects = self.controller.submit(problem, mission_id, self.wall(), settings,
-                                                   queue)
+        journal = None
         if self.journal_dir is not None:
             journal = Journal(journal_path(self.journal_dir, mission_id))
-            journal.write(MissionRecord(mission_id, text, name, panels, shift, origin,
-                                        settings.__dict__, self.wall(), queued=position > 0))
+            try:
+                journal.write(MissionRecord(mission_id, text, name, panels, shift, origin,
+                                            settings.__dict__, self.wall(),
+                                            queued=self.controller.busy))
+            except JournalError:
+                journal.discard()
+                raise
+        try:
+            position, effects = self.controller.submit(problem, mission_id, self.wall(),
+                                                       settings, queue)
+        except ValueError:
+            if journal is not None:
+                journal.discard()
+            raise
+        if journal is not None:
             if position:
                 journal.close()
             else:
@@ -398,15 +429,19 @@ class PlannerNode(Node):
         started = [(path, records) for path, records in unfinished
                    if not waits_in_queue(records)]
         origin = self.resume(started) if started else ''
+        # A mission set aside and tried again finds its queue still in memory.
         self.requeue([(path, records) for path, records in unfinished
-                      if waits_in_queue(records)])
+                      if waits_in_queue(records)
+                      and not self.controller.position(records[0].mission_id)])
         return origin
 
     def resume(self, started) -> str:
         log = self.get_logger()
         for path, _ in started[:-1]:
-            close_journal(path, EndRecord('failed', ('abandoned: a newer mission was '
-                                                     'resumed',)))
+            why = close_journal(path, EndRecord('failed', ('abandoned: a newer mission was '
+                                                           'resumed',)))
+            if why:
+                log.warning(f'cannot close an abandoned mission: {why}')
         path, records = started[-1]
         head: MissionRecord = records[0]
         try:
@@ -414,10 +449,17 @@ class PlannerNode(Node):
         except ProblemError as error:
             log.error(f'cannot resume the mission of {path}: ' + '; '.join(error.problems))
             return ''
-        self.journal = Journal(path)
+        try:
+            self.journal = Journal(path)
+        except JournalError as error:
+            self.journal_blocked = (head.mission_id, f'cannot resume: {error}', self.wall())
+            log.error(f"mission '{head.mission_id}' {self.journal_blocked[1]}")
+            return head.origin
         log.warning(f"resuming mission '{head.mission_id}' from {path}")
         self.carry_out(self.controller.resume(head.mission_id, problem, settings,
                                               head.accepted, records[1:], self.wall()))
+        if self.journal is None:
+            return head.origin  # set aside again
         self.publish_journaled_plan(head.mission_id)
         # The previous process's event history died with it, and a completion it published
         # just before it was killed may never have reached anyone: declared again, with its
@@ -435,7 +477,10 @@ class PlannerNode(Node):
             try:
                 problem, settings = self.journaled(records)
             except ProblemError as error:
-                close_journal(path, EndRecord('failed', tuple(error.problems)))
+                why = close_journal(path, EndRecord('failed', tuple(error.problems)))
+                self.get_logger().error(f'cannot queue the mission of {path} again: '
+                                        + '; '.join(error.problems)
+                                        + (f' (and cannot close it: {why})' if why else ''))
                 continue
             position = self.controller.requeue(problem, head.mission_id, head.accepted,
                                                settings)
@@ -669,7 +714,11 @@ class PlannerNode(Node):
             response.problems = [shorten(p, 500) for p in error.problems]
             return response
         if self.journal is not None:
-            self.journal.write(JobsAddedRecord(request.fragment_yaml, jobs))
+            try:
+                self.journal.write(JobsAddedRecord(request.fragment_yaml, jobs))
+            except JournalError as error:
+                response.message = f'{error}; the mission is unchanged'
+                return response
         self.carry_out(self.controller.add_jobs(problem, jobs, self.wall()))
         response.success, response.jobs = True, list(jobs)
         response.message = f"{len(jobs)} job(s) added to mission '{mission.id}'"
@@ -685,12 +734,26 @@ class PlannerNode(Node):
             self.take_role(change)
         if self.withdraw_at is not None and wall >= self.withdraw_at:
             self.withdraw()
+        if self.journal_blocked is not None:
+            if wall - self.journal_blocked[2] < JOURNAL_RETRY:
+                return
+            # The queue waits meanwhile: its missions must not start before the one set aside.
+            self.journal_blocked = None
+            self.resume_unfinished()
+            if self.journal_blocked is not None:
+                return
         if self.journal is not None:
-            self.journal.sync()
+            try:
+                self.journal.sync()
+            except JournalError as error:
+                self.set_aside(error)
+                return
         self.carry_out(self.controller.tick(wall, self.plan_pub.get_subscription_count()))
 
     def on_robot_state(self, msg: RobotState) -> None:
-        if not self.auth.accept(msg, ROBOT_STATES_TOPIC, {msg.robot}):
+        why = self.auth.refusal(msg, ROBOT_STATES_TOPIC, {msg.robot})
+        if why:
+            self.controller.unverified_state(msg.robot, why, self.wall())
             return
         mode = MODE_FROM_MSG.get(msg.mode)
         if mode is None:
@@ -813,39 +876,65 @@ class PlannerNode(Node):
     def carry_out(self, effects) -> None:
         if not effects:
             return
-        for effect in effects:
-            if isinstance(effect, Solve):
-                self.solve(effect)
-            elif isinstance(effect, PublishPlan):
-                self.publish_plan(effect)
-            elif isinstance(effect, ResendPlan):
-                self.resend_plan(effect)
-            elif isinstance(effect, JobDone):
-                self.publish_job_done(effect)
-            elif isinstance(effect, Note):
-                if effect.kind == MissionEventKind.MISSION_STARTED:
-                    self.begin()
-                self.tell(effect)
-                if effect.kind in ENDINGS:
-                    self.end(ENDINGS[effect.kind], effect.reasons)
-            elif isinstance(effect, LeftQueue):
-                self.left_queue(effect)
+        try:
+            for effect in effects:
+                if isinstance(effect, Solve):
+                    self.solve(effect)
+                elif isinstance(effect, PublishPlan):
+                    self.publish_plan(effect)
+                elif isinstance(effect, ResendPlan):
+                    self.resend_plan(effect)
+                elif isinstance(effect, JobDone):
+                    self.publish_job_done(effect)
+                elif isinstance(effect, Note):
+                    if effect.kind == MissionEventKind.MISSION_STARTED:
+                        self.begin()
+                    self.tell(effect)
+                    if effect.kind in ENDINGS:
+                        self.end(ENDINGS[effect.kind], effect.reasons)
+                elif isinstance(effect, LeftQueue):
+                    self.left_queue(effect)
+        except JournalError as error:
+            self.set_aside(error)
         self.publish_jobs()
         self.publish_status()
+
+    def set_aside(self, error: JournalError) -> None:
+        """The journal cannot take what the mission must record before the fleet hears it:
+        nothing more is published. The mission is dropped as a planner that died would drop
+        it, and resumed from its journal and the robots' histories (as after a restart) once
+        the journal can be written again; meanwhile the robots finish what they were given
+        and wait, and the status says why."""
+        mission = self.controller.forget()
+        if self.journal is not None:
+            self.journal.close()
+        self.journal = None
+        self.solves.clear()
+        self.journal_blocked = (mission.id, f'{error}; nothing more is planned or declared '
+                                f'done until it can be written (tried again every '
+                                f'{JOURNAL_RETRY:g} s)', self.wall())
+        self.get_logger().error(f"mission '{mission.id}' set aside: "
+                                f'{self.journal_blocked[1]}')
 
     def end(self, state: MissionState, reasons) -> None:
         """The running mission ended: its journal is closed and its goal answered."""
         if self.journal is not None:
-            self.journal.write(EndRecord(str(state), tuple(reasons)))
+            try:
+                self.journal.write(EndRecord(str(state), tuple(reasons)))
+            except JournalError as error:
+                self.get_logger().error(f'the end of the mission is not journaled: {error}')
             self.journal.close()
             plan_file(self.journal.path).unlink(missing_ok=True)
             self.journal = None
         self.answer_goal(self.controller.mission.id, self.result_of(state))
 
     def left_queue(self, effect: LeftQueue) -> None:
-        if self.journal_dir is not None:
-            close_journal(journal_path(self.journal_dir, effect.mission_id),
-                          EndRecord(str(effect.state), effect.reasons))
+        why = '' if self.journal_dir is None else close_journal(
+            journal_path(self.journal_dir, effect.mission_id),
+            EndRecord(str(effect.state), effect.reasons))
+        if why:
+            self.get_logger().error(f"the end of mission '{effect.mission_id}' is not "
+                                    f'journaled: {why}')
         self.get_logger().warning(f"mission '{effect.mission_id}' left the queue, "
                                   f'{effect.state}: ' + shorten('; '.join(effect.reasons), 500))
         self.answer_goal(effect.mission_id, RunMission.Result(
@@ -854,12 +943,6 @@ class PlannerNode(Node):
 
     def publish_plan(self, effect: PublishPlan) -> None:
         mission = self.controller.mission
-        if self.journal is not None:
-            # On disk before any robot can follow it.
-            self.journal.write(PlanRecord(
-                effect.revision, effect.mission_start,
-                None if effect.cancelled else effect.result.schedule, effect.continued,
-                effect.reasons, dict(effect.starts), dict(effect.incarnations)))
         stamp = self.get_clock().now().to_msg()
         start = Time(nanoseconds=int(effect.mission_start * 1e9)).to_msg()
         if effect.cancelled:
@@ -869,10 +952,16 @@ class PlannerNode(Node):
             msg = plan_msg(mission.problem, effect.posed, effect.result.schedule, effect.result,
                            mission.id, effect.revision, start, mission.settings.time_scale,
                            stamp, effect.restarted_in, effect.reasons, effect.incarnations)
+        if self.journal is not None:
+            # On disk before any robot can follow it; the message first: a restarted planner
+            # publishes it again only if the journal's latest revision is its own.
+            write_plan_file(plan_file(self.journal.path), msg)
+            self.journal.write(PlanRecord(
+                effect.revision, effect.mission_start,
+                None if effect.cancelled else effect.result.schedule, effect.continued,
+                effect.reasons, dict(effect.starts), dict(effect.incarnations)))
         self.last_published = (msg.mission_id, msg.revision, msg.stamp)
         self.last_plan = msg
-        if self.journal is not None:
-            write_plan_file(plan_file(self.journal.path), msg)
         self.plan_pub.publish(self.auth.sign(msg, PLAN_TOPIC))
         log = self.get_logger()
         if effect.cancelled:
@@ -1001,6 +1090,14 @@ class PlannerNode(Node):
         if not self.speaking:
             return
         view = self.controller.status(self.wall())
+        if view is None and self.journal_blocked is not None:
+            mission_id, why, _ = self.journal_blocked
+            self.status_pub.publish(self.auth.sign(MissionStatus(
+                stamp=self.get_clock().now().to_msg(), mission_id=mission_id,
+                state=STATE_TO_MSG[MissionState.BLOCKED], blocked_reasons=[why],
+                planned_makespan=math.nan, projected_makespan=math.nan,
+                ignored_unauthenticated=self.auth.rejected), MISSION_STATUS_TOPIC))
+            return
         if view is None:
             # Heard by `mission status`, monitors and recorders before any mission: they
             # know the planner is there, waiting for one.
@@ -1033,11 +1130,18 @@ class PlannerNode(Node):
         return super().destroy_node()
 
 
-def close_journal(path: Path, end: EndRecord) -> None:
-    """End the journal of a mission that is not the running one."""
-    journal = Journal(path)
-    journal.write(end)
-    journal.close()
+def close_journal(path: Path, end: EndRecord) -> str:
+    """End the journal of a mission that is not the running one; why it cannot be ('' once
+    it is)."""
+    try:
+        journal = Journal(path)
+        try:
+            journal.write(end)
+        finally:
+            journal.close()
+    except JournalError as error:
+        return str(error)
+    return ''
 
 
 def plan_file(journal: Path) -> Path:
@@ -1049,8 +1153,13 @@ def write_plan_file(path: Path, msg: Plan) -> None:
     """`msg` in `path`, whole or not at all: a process killed while writing leaves the
     previous one."""
     partial = path.with_name(path.name + '.partial')
-    partial.write_bytes(serialize_message(msg))
-    partial.replace(path)
+    try:
+        partial.write_bytes(serialize_message(msg))
+        partial.replace(path)
+    except OSError as error:
+        partial.unlink(missing_ok=True)
+        raise JournalError(f'{path}: cannot write the plan: {error.strerror or error}'
+                           ) from None
 
 
 def main(args=None):

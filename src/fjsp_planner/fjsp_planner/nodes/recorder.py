@@ -4,19 +4,25 @@ FILE.mcap`, Foxglove, `ros2 bag`).
 
 It subscribes with the QoS each topic is published with, so it gets the latched plan and
 status and the event histories even when started late, and stores each message's CDR bytes
-untouched (raw subscriptions: nothing is decoded or re-encoded). It flushes every
-`flush_period` seconds, so a recorder killed without warning loses at most that much.
+untouched (raw subscriptions: nothing is re-encoded). With the fleet key (`fleet_key_file`)
+it stores only what verifies, as the fleet's nodes believe only that: the rest is dropped,
+counted per topic in the recording's metadata and in its log, so that a recording tells the
+mission the fleet ran rather than what a forger said. It flushes every `flush_period`
+seconds, so a recorder killed without warning loses at most that much.
 """
 
 import sys
 import time
+from collections import Counter
 from datetime import UTC, datetime
 from pathlib import Path
 
 from ament_index_python.packages import PackageNotFoundError, get_package_share_directory
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, ReliabilityPolicy
+from rclpy.serialization import deserialize_message
 
+from fjsp_common.auth import NodeAuth, signers_of
 from fjsp_common.contract import TOPICS, subscription
 from fjsp_common.fleet import RECORDER_NODE
 from fjsp_common.parameters import ParameterSpec, table
@@ -75,6 +81,11 @@ class RecorderNode(Node):
             raise ParameterError(f'cannot record to {directory / name}: '
                                  f'{error.strerror or error}') from None
         self.failed = False
+        self.auth = NodeAuth(self, RECORDER_NODE)
+        self.dropped: Counter[str] = Counter()
+        """Messages per topic that did not verify with the fleet key: not written."""
+        self.noted: Counter[str] = Counter()
+        """`dropped` as the recording's metadata last said it."""
         try:
             for topic in TOPICS:
                 # The QoS its readers use: a replay's one writer stands for all the fleet's.
@@ -85,16 +96,20 @@ class RecorderNode(Node):
                     Offer(reliable=qos.reliability == ReliabilityPolicy.RELIABLE,
                           transient_local=qos.durability == DurabilityPolicy.TRANSIENT_LOCAL,
                           depth=qos.depth))
-                subscription(self, topic, self.recording(channel), raw=True)
+                signed = self.auth.enabled and 'auth' in topic.type.get_fields_and_field_types()
+                subscription(self, topic, self.recording(channel, topic if signed else None),
+                             raw=True)
         except RecordingError as error:
             self.writer.close()
             raise ParameterError(f'cannot record: {error}') from None
         self.create_timer(value['flush_period'], self.flush)
         self.get_logger().info(f'recording {len(TOPICS)} topics to {self.writer.path}')
 
-    def recording(self, channel: int):
+    def recording(self, channel: int, signed=None):
+        """The callback writing a topic's messages to `channel`; for a `signed` topic, only
+        those that verify."""
         def record(data: bytes) -> None:
-            if self.failed:
+            if self.failed or (signed is not None and not self.verifies(signed, data)):
                 return
             try:
                 self.writer.write(channel, data, time.time_ns())
@@ -102,10 +117,24 @@ class RecorderNode(Node):
                 self.stop_recording(error)
         return record
 
+    def verifies(self, topic, data: bytes) -> bool:
+        try:
+            msg = deserialize_message(data, topic.type)
+        except Exception:  # noqa: BLE001  bytes rclpy cannot read, whatever it raises
+            self.dropped[self.resolve_topic_name(topic.name)] += 1
+            return False
+        if self.auth.accept(msg, topic.name, signers_of(msg)):
+            return True
+        self.dropped[self.resolve_topic_name(topic.name)] += 1
+        return False
+
     def flush(self) -> None:
         if self.failed:
             return
         try:
+            if self.dropped != self.noted:
+                self.writer.note_dropped(self.dropped)
+                self.noted = Counter(self.dropped)
             self.writer.flush()
         except OSError as error:
             self.stop_recording(error)
@@ -118,12 +147,18 @@ class RecorderNode(Node):
     def destroy_node(self):
         if not self.failed:
             try:
+                if self.dropped != self.noted:
+                    self.writer.note_dropped(self.dropped)
                 self.writer.close()
             except OSError as error:
                 self.stop_recording(error)
         counts = ', '.join(f'{topic} {n}' for topic, n in sorted(self.writer.counts.items()))
         self.get_logger().info(f'recorded {self.writer.counts.total()} messages to '
                                f'{self.writer.path}' + (f' ({counts})' if counts else ''))
+        if self.dropped:
+            self.get_logger().warning(
+                f'dropped {self.dropped.total()} messages that do not verify with the fleet '
+                'key: ' + ', '.join(f'{t} {n}' for t, n in sorted(self.dropped.items())))
         return super().destroy_node()
 
 

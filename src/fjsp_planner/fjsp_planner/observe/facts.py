@@ -6,9 +6,11 @@ names but not the same classes, and only the live one carries the message consta
 message definitions stored in the recording (replay), and pairs each constant with the
 vocabulary word of the same name, as `fjsp_common.contract` does for the nodes. Numbers the
 decoder does not know (a newer fleet, a forged message) raise `UnreadableMessageError` instead
-of being guessed.
+of being guessed, as do fields of the wrong type (a recording can hold any schema) and times
+that are not finite numbers (`fjsp_common.wellformed`).
 """
 
+import math
 import re
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -16,6 +18,7 @@ from dataclasses import dataclass
 from fjsp_common.clock import ScheduleClock, seconds
 from fjsp_common.revisions import attempt_revision
 from fjsp_common.vocabulary import EventKind, MissionEventKind, MissionState, RobotMode
+from fjsp_common.wellformed import plan_problem, time_problem
 
 VOCABULARIES = {
     'RobotState': ('MODE', RobotMode),
@@ -24,6 +27,10 @@ VOCABULARIES = {
     'MissionEvent': ('KIND', MissionEventKind),
 }
 """Message type -> (prefix of its constants, the vocabulary they name)."""
+
+
+MAX_NAME = 256
+"""Characters of a name or id: a scenario's names have at most 100, ids a few more."""
 
 
 class UnreadableMessageError(ValueError):
@@ -206,70 +213,150 @@ class Decoder:
     def _word(self, type_name: str, value: int):
         try:
             return self._words[type_name][value]
-        except KeyError:
+        except (KeyError, TypeError):
             raise UnreadableMessageError(f'{type_name} value {value} has no known meaning'
                                          ) from None
 
     def read(self, type_name: str, msg) -> Fact | None:
         """The fact `msg` (a message of type `type_name`) states, or None for a type the
-        history does not use."""
+        history does not use. UnreadableMessageError for a message with a field of the wrong
+        type, a time that is not a finite number, or a constant with no known meaning."""
         reader = {'Plan': self.plan, 'TaskEvent': self.task_event,
                   'MissionEvent': self.mission_event, 'RobotState': self.robot_state,
                   'MissionStatus': self.status}.get(short_type(type_name))
-        return reader(msg) if reader else None
+        if reader is None:
+            return None
+        try:
+            return reader(msg)
+        except AttributeError as error:
+            raise UnreadableMessageError(f'{short_type(type_name)}: {error}') from None
 
     def plan(self, msg) -> PlanFact:
+        malformed = plan_problem(msg)
+        if malformed:
+            raise UnreadableMessageError(f'Plan: {malformed}')
         tasks = tuple(
-            PlannedTask(robot=r.robot, job=t.job, operation=t.operation_name,
-                        location=t.location, travel_start=t.travel_start, arrival=t.arrival,
-                        start=t.start, operation_end=t.operation_end, end=t.end,
-                        co_workers=tuple(t.co_workers), predecessors=tuple(t.predecessors),
+            PlannedTask(robot=_name(r.robot), job=_name(t.job),
+                        operation=_name(t.operation_name), location=_name(t.location),
+                        travel_start=t.travel_start, arrival=t.arrival, start=t.start,
+                        operation_end=t.operation_end, end=t.end,
+                        co_workers=_names(t.co_workers), predecessors=_names(t.predecessors),
                         held_into_next=bool(t.held_into_next), continued=bool(t.continued),
                         # A recording made before plans carried it decodes without it.
-                        restarted_in=int(getattr(t, 'restarted_in', 0)))
+                        restarted_in=_count(getattr(t, 'restarted_in', 0)))
             for r in msg.robots for t in r.tasks)
-        return PlanFact(stamp=seconds(msg.stamp), mission_id=msg.mission_id,
-                        revision=msg.revision, scenario_id=msg.scenario_id,
-                        mission_start=seconds(msg.mission_start), time_scale=msg.time_scale,
-                        cancelled=bool(msg.cancelled), makespan=msg.makespan,
-                        solver_status=msg.solver_status, lower_bound=msg.lower_bound,
-                        reasons=tuple(msg.reasons),
-                        robots=tuple((r.robot, r.robot_type) for r in msg.robots), tasks=tasks,
+        return PlanFact(stamp=_stamp(msg.stamp), mission_id=_name(msg.mission_id),
+                        revision=_count(msg.revision), scenario_id=_name(msg.scenario_id),
+                        mission_start=_stamp(msg.mission_start),
+                        time_scale=float(msg.time_scale), cancelled=bool(msg.cancelled),
+                        makespan=_measure(msg.makespan),
+                        solver_status=_text(msg.solver_status),
+                        lower_bound=_measure(msg.lower_bound), reasons=_texts(msg.reasons),
+                        robots=tuple((_name(r.robot), _name(r.robot_type)) for r in msg.robots),
+                        tasks=tasks,
                         # A recording made before plans carried a map decodes without one.
-                        places=tuple(MapPlace(p.name, p.x, p.y, p.z)
+                        places=tuple(MapPlace(_name(p.name), _coordinate(p.x), _coordinate(p.y),
+                                              _coordinate(p.z))
                                      for p in getattr(msg, 'places', ())))
 
     def task_event(self, msg) -> TaskEventFact:
-        return TaskEventFact(stamp=seconds(msg.stamp), event_id=msg.event_id,
-                             mission_id=msg.mission_id, kind=self._word('TaskEvent', msg.kind),
-                             robot=msg.robot, job=msg.job, revision=msg.plan_revision,
-                             time=msg.time, reason=msg.reason)
+        return TaskEventFact(stamp=_stamp(msg.stamp), event_id=_name(msg.event_id),
+                             mission_id=_name(msg.mission_id),
+                             kind=self._word('TaskEvent', msg.kind), robot=_name(msg.robot),
+                             job=_name(msg.job), revision=_count(msg.plan_revision),
+                             time=_time(msg.time, 'TaskEvent time'),
+                             reason=_text(msg.reason))
 
     def mission_event(self, msg) -> MissionEventFact:
-        return MissionEventFact(stamp=seconds(msg.stamp), event_id=msg.event_id,
-                                mission_id=msg.mission_id,
+        return MissionEventFact(stamp=_stamp(msg.stamp), event_id=_name(msg.event_id),
+                                mission_id=_name(msg.mission_id),
                                 kind=self._word('MissionEvent', msg.kind),
-                                revision=msg.plan_revision, time=msg.time, robot=msg.robot,
-                                job=msg.job, reasons=tuple(msg.reasons))
+                                revision=_count(msg.plan_revision),
+                                time=_time(msg.time, 'MissionEvent time'),
+                                robot=_name(msg.robot), job=_name(msg.job),
+                                reasons=_texts(msg.reasons))
 
     def robot_state(self, msg) -> RobotStateFact:
-        return RobotStateFact(stamp=seconds(msg.stamp), robot=msg.robot,
-                              robot_type=msg.robot_type, incarnation=msg.incarnation,
-                              mission_id=msg.mission_id, mode=self._word('RobotState', msg.mode),
-                              revision=msg.plan_revision, refusal=msg.refusal,
-                              failures=msg.failures, current_job=msg.current_job,
-                              location=msg.location, destination=msg.destination,
-                              progress=msg.progress, busy_until=msg.busy_until)
+        return RobotStateFact(stamp=_stamp(msg.stamp), robot=_name(msg.robot),
+                              robot_type=_name(msg.robot_type),
+                              incarnation=_count(msg.incarnation),
+                              mission_id=_name(msg.mission_id),
+                              mode=self._word('RobotState', msg.mode),
+                              revision=_count(msg.plan_revision), refusal=_text(msg.refusal),
+                              failures=_count(msg.failures),
+                              current_job=_name(msg.current_job), location=_name(msg.location),
+                              destination=_name(msg.destination),
+                              progress=_measure(msg.progress),
+                              busy_until=_measure(msg.busy_until))
 
     def status(self, msg) -> StatusFact:
-        return StatusFact(stamp=seconds(msg.stamp), mission_id=msg.mission_id,
+        return StatusFact(stamp=_stamp(msg.stamp), mission_id=_name(msg.mission_id),
                           state=self._word('MissionStatus', msg.state),
-                          revision=msg.plan_revision, scenario_id=msg.scenario_id,
-                          jobs_done=msg.jobs_done, jobs_running=msg.jobs_running,
-                          jobs_total=msg.jobs_total, planned_makespan=msg.planned_makespan,
-                          projected_makespan=msg.projected_makespan, elapsed=msg.elapsed,
-                          blocked_reasons=tuple(msg.blocked_reasons),
-                          replan_reasons=tuple(msg.replan_reasons),
-                          warnings=tuple(msg.warnings),
-                          ignored=(msg.ignored_stale, msg.ignored_duplicate,
-                                   msg.ignored_unknown))
+                          revision=_count(msg.plan_revision),
+                          scenario_id=_name(msg.scenario_id), jobs_done=_count(msg.jobs_done),
+                          jobs_running=_count(msg.jobs_running),
+                          jobs_total=_count(msg.jobs_total),
+                          planned_makespan=_measure(msg.planned_makespan),
+                          projected_makespan=_measure(msg.projected_makespan),
+                          elapsed=_measure(msg.elapsed),
+                          blocked_reasons=_texts(msg.blocked_reasons),
+                          replan_reasons=_texts(msg.replan_reasons),
+                          warnings=_texts(msg.warnings),
+                          ignored=(_count(msg.ignored_stale), _count(msg.ignored_duplicate),
+                                   _count(msg.ignored_unknown)))
+
+
+def _text(value) -> str:
+    if not isinstance(value, str):
+        raise UnreadableMessageError(f'{value!r:.80} where text belongs')
+    return value
+
+
+def _name(value) -> str:
+    """A name or id: text no longer than any a fleet gives."""
+    if len(_text(value)) > MAX_NAME:
+        raise UnreadableMessageError(f'a name of {len(value)} characters')
+    return value
+
+
+def _names(values) -> tuple[str, ...]:
+    return tuple(_name(value) for value in _texts(values))
+
+
+def _texts(values) -> tuple[str, ...]:
+    if isinstance(values, str | bytes):
+        raise UnreadableMessageError(f'{values!r:.80} where a list of texts belongs')
+    return tuple(_text(value) for value in values)
+
+
+def _count(value) -> int:
+    if isinstance(value, bool) or not isinstance(value, int) or value < 0:
+        raise UnreadableMessageError(f'{value!r:.80} where a count belongs')
+    return value
+
+
+def _time(value, what: str) -> float:
+    why = time_problem(value, what)
+    if why:
+        raise UnreadableMessageError(why)
+    return float(value)
+
+
+def _measure(value) -> float:
+    """A number that may be missing (NaN: no bound, nothing busy); one beyond any time a
+    mission can reach counts as missing too."""
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise UnreadableMessageError(f'{value!r:.80} where a number belongs')
+    return float(value) if not time_problem(value, '') else math.nan
+
+
+def _coordinate(value) -> float:
+    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+        raise UnreadableMessageError(f'{value!r:.80} where a coordinate belongs')
+    return float(value)
+
+
+def _stamp(stamp) -> float:
+    if not isinstance(stamp.sec, int) or not isinstance(stamp.nanosec, int):
+        raise UnreadableMessageError(f'stamp {stamp!r:.80} is not a time')
+    return seconds(stamp)

@@ -38,6 +38,12 @@ ACTIVITY_STYLE = {
     'holding': {'color': 'royalblue', 'linewidth': 3.0, 'linestyle': '-'},
 }
 HEALTH_COLOUR = {'failed': ('red', 0.14), 'offline': ('grey', 0.28)}
+MAX_ROWS = 100
+"""Robots drawn, in the timeline's order."""
+MAX_NOTES = 12
+"""Revisions whose reasons are listed under the chart."""
+LABEL = 30
+"""Characters of a robot's name shown."""
 
 
 def job_colours(jobs) -> dict:
@@ -47,7 +53,9 @@ def job_colours(jobs) -> dict:
 
 def draw_mission(timeline: dict, header: dict, path: Path) -> Drawn:
     """Write the chart of `timeline` (from `views.timeline`) to `path` (PNG)."""
-    robots = timeline['robots']
+    # What a figure can hold whatever a recording names: a forged flood of robot names or
+    # of re-plans must not make an image too large to draw.
+    robots = timeline['robots'][:MAX_ROWS]
     rows = {robot: len(robots) - 1 - index for index, robot in enumerate(robots)}
     end = max(timeline['end'] or 1.0, 1.0)
     now_units = timeline['now']
@@ -56,13 +64,17 @@ def draw_mission(timeline: dict, header: dict, path: Path) -> Drawn:
     notes = [f"r{r['number']} at t={decimal(r['time'])}: "
              + ('; '.join(r['reasons']) or 'no reason given')
              for r in timeline['revisions'] if r['number'] > 1 and r['time'] is not None]
+    if len(notes) > MAX_NOTES:
+        notes = notes[:MAX_NOTES - 1] + [f'... and {len(notes) - MAX_NOTES + 1} more '
+                                         'revisions']
+    notes = [_cut(note, 300) for note in notes]
     # Heights in inches: title, one per robot, axis and legend, a line per revision's reasons.
     below = 1.1 + 0.17 * len(notes)
     height = 0.65 + 0.95 * len(robots) + below
     width = chart_width(end, 0.1, 7.0, 11.0)
     fig, ax = plt.subplots(figsize=(width, height), dpi=DPI)
     labels = BarLabels(ax)
-    label = 0.2 + 0.075 * max((len(r) for r in robots), default=4)
+    label = 0.2 + 0.075 * max((min(len(r), LABEL) for r in robots), default=4)
     fig.subplots_adjust(left=label / width, right=0.99, top=1 - 0.55 / height,
                         bottom=below / height)
 
@@ -101,8 +113,9 @@ def draw_mission(timeline: dict, header: dict, path: Path) -> Drawn:
         style = OUTCOME_STYLE.get(w['outcome'], OUTCOME_STYLE['done'])
         ax.barh(y, max(stop - w['start'], 0.05), left=w['start'], height=0.3,
                 color=colour[w['job']], **style)
-        labels.add(w['job'] + (f"#{w['attempt']}" if w['attempt'] > 1 else ''), w['start'],
-                   stop, y, color='black' if w['outcome'] != 'voided' else 'dimgrey')
+        if 0 <= (w['start'] + stop) / 2 <= end:  # a text far off the axes cannot be placed
+            labels.add(w['job'] + (f"#{w['attempt']}" if w['attempt'] > 1 else ''), w['start'],
+                       stop, y, color='black' if w['outcome'] != 'voided' else 'dimgrey')
     for a in timeline['activities']:
         style = ACTIVITY_STYLE.get(a['mode'])
         if style and a['robot'] in rows:
@@ -114,13 +127,15 @@ def draw_mission(timeline: dict, header: dict, path: Path) -> Drawn:
         if r['time'] is None:
             continue
         x = max(r['time'], 0.0)
+        if x > end:
+            continue
         ax.axvline(x, color='purple', linestyle='--', lw=1)
         ax.text(x, len(robots) - 0.45, f" r{r['number']}", color='purple', fontsize=8,
                 va='bottom')
-    if now_units is not None and not header['ended']:
+    if now_units is not None and not header['ended'] and 0 <= now_units <= end:
         ax.axvline(now_units, color='black', lw=1.2)
         ax.text(now_units, -0.62, ' now', fontsize=8)
-    ax.set_yticks(range(len(robots)), list(reversed(robots)))
+    ax.set_yticks(range(len(robots)), [_cut(r, LABEL) for r in reversed(robots)])
     ax.set_ylim(-0.65, len(robots) - 0.3)
     ax.set_xlim(0, end * 1.02)
     ax.grid(axis='x', alpha=0.25)
@@ -154,6 +169,10 @@ def _title(h: dict) -> str:
     return (f"{h['scenario']} - mission {h['mission_id']}: {h['state']}, "
             f"{h['jobs_done']}/{h['jobs_total']} jobs done{agree}\nrevision {h['revision']}; "
             f'makespan planned {first} (r1), {latest} (latest), executed {executed}')
+
+
+def _cut(text: str, length: int) -> str:
+    return text if len(text) <= length else text[:length - 1] + '\u2026'
 
 
 def _legend(plans: int) -> list:

@@ -22,13 +22,16 @@ from pathlib import Path
 
 import mcap
 from mcap.exceptions import McapError
-from mcap.reader import NonSeekingReader
+from mcap.records import Channel, Message, Metadata, Schema
+from mcap.stream_reader import StreamReader
 from mcap.well_known import MessageEncoding, SchemaEncoding
 from mcap.writer import CompressionType, Writer
 from mcap_ros2.decoder import DecoderFactory
 
+from fjsp_common.auth import Verifier, signers_of
 from fjsp_common.fleet import HEARTBEAT_TIMEOUT
-from fjsp_planner.observe.facts import Decoder, UnreadableMessageError
+from fjsp_common.vocabulary import EventKind
+from fjsp_planner.observe.facts import Decoder, TaskEventFact, UnreadableMessageError
 from fjsp_planner.observe.history import FleetHistory
 
 SEPARATOR = '=' * 80
@@ -38,6 +41,9 @@ COMPRESSIONS = {'zstd': CompressionType.ZSTD, 'lz4': CompressionType.LZ4,
                 'none': CompressionType.NONE}
 INFINITE = {'sec': 9223372036, 'nsec': 854775807}
 """rmw's 'infinite' duration, as rosbag2 writes it for deadline, lifespan and lease."""
+DROPPED = 'fjsp_dropped_unverified'
+"""Name of the metadata records in which a recorder with a fleet key says, per topic, how
+many messages it dropped because they do not verify (the latest record counts)."""
 
 
 class RecordingError(ValueError):
@@ -164,6 +170,10 @@ class RecordingWriter:
                                  publish_time=log_time_ns, sequence=self.counts.total())
         self.counts[self._topics[channel]] += 1
 
+    def note_dropped(self, counts) -> None:
+        """Record how many messages of each topic were dropped so far (not written)."""
+        self._writer.add_metadata(DROPPED, {topic: str(n) for topic, n in counts.items()})
+
     def flush(self) -> None:
         """Put everything received so far on disk (it survives a crash of the recorder)."""
         self._writer.flush()
@@ -201,6 +211,12 @@ class Reading:
     """Why reading stopped before the end of the file ('' when it did not)."""
     undecodable: Counter = field(default_factory=Counter)
     """Messages per topic that could not be decoded."""
+    unverified: Counter = field(default_factory=Counter)
+    """Messages per topic left out because they do not verify with the fleet key."""
+    unverified_why: Counter = field(default_factory=Counter)
+    """The same, per reason."""
+    dropped_by_recorder: dict[str, int] = field(default_factory=dict)
+    """Messages per topic the recorder dropped as not verifying (never written)."""
     last_time: float = 0.0
 
 
@@ -216,27 +232,38 @@ def read_recording(path: Path, reading: Reading | None = None) -> Iterator[Recor
         stream = Path(path).open('rb')
     except OSError as error:
         raise RecordingError(f'cannot open recording {path}: {error.strerror}') from None
+    schemas: dict[int, Schema] = {}
+    channels: dict[int, Channel] = {}
     with stream:
         try:
-            reader = NonSeekingReader(stream)
-            messages = reader.iter_messages(log_time_order=False)
-            for schema, channel, record in _until_damaged(messages, reading):
-                if schema is None or schema.encoding != SchemaEncoding.ROS2:
-                    continue
-                reading.types[channel.topic] = schema.name
-                reading.definitions.setdefault(schema.name, schema.data.decode())
-                reading.counts[channel.topic] += 1
-                reading.last_time = max(reading.last_time, record.log_time * 1e-9)
-                try:
-                    decode = decoders.decoder_for(channel.message_encoding, schema)
-                    message = decode(record.data) if decode else None
-                except (McapError, ValueError, IndexError, KeyError, TypeError):
-                    message = None
-                if message is None:
-                    reading.undecodable[channel.topic] += 1
-                    continue
-                yield RecordedMessage(channel.topic, schema.name, record.log_time * 1e-9,
-                                      message)
+            for record in _until_damaged(iter(StreamReader(stream).records), reading):
+                if isinstance(record, Schema):
+                    schemas[record.id] = record
+                elif isinstance(record, Channel):
+                    channels[record.id] = record
+                elif isinstance(record, Metadata) and record.name == DROPPED:
+                    reading.dropped_by_recorder = {
+                        topic: int(n) for topic, n in record.metadata.items() if n.isdigit()}
+                elif isinstance(record, Message) and record.channel_id in channels:
+                    channel = channels[record.channel_id]
+                    schema = schemas.get(channel.schema_id)
+                    if schema is None or schema.encoding != SchemaEncoding.ROS2:
+                        continue
+                    reading.types[channel.topic] = schema.name
+                    reading.definitions.setdefault(schema.name, schema.data.decode(
+                        errors='replace'))
+                    reading.counts[channel.topic] += 1
+                    reading.last_time = max(reading.last_time, record.log_time * 1e-9)
+                    try:
+                        decode = decoders.decoder_for(channel.message_encoding, schema)
+                        message = decode(record.data) if decode else None
+                    except Exception:  # noqa: BLE001  a damaged or hostile record, of any kind
+                        message = None
+                    if message is None:
+                        reading.undecodable[channel.topic] += 1
+                        continue
+                    yield RecordedMessage(channel.topic, schema.name, record.log_time * 1e-9,
+                                          message)
         except McapError as error:
             raise RecordingError(f'cannot read {path} as an MCAP recording: {error}') from None
 
@@ -256,11 +283,13 @@ def _until_damaged(messages, reading: Reading):
         yield item
 
 
-def replay(path: Path, heartbeat_timeout: float = HEARTBEAT_TIMEOUT
+def replay(path: Path, heartbeat_timeout: float = HEARTBEAT_TIMEOUT, key: bytes | None = None
            ) -> tuple[FleetHistory, Reading]:
-    """The fleet's history as the recording tells it, and what reading it found."""
+    """The fleet's history as the recording tells it, and what reading it found. With the
+    fleet `key`, only what verifies with it is believed, as the fleet's nodes believe it."""
     reading = Reading()
     fleet = FleetHistory(heartbeat_timeout)
+    verifier = Verifier(key) if key is not None else None
     decoder, known = None, 0
     unreadable = Counter()
     for recorded in read_recording(path, reading):
@@ -270,10 +299,31 @@ def replay(path: Path, heartbeat_timeout: float = HEARTBEAT_TIMEOUT
                 len(reading.definitions)
         try:
             fact = decoder.read(recorded.type_name, recorded.message)
-        except (UnreadableMessageError, AttributeError):
+        except UnreadableMessageError:
             unreadable[recorded.topic] += 1
             continue
-        if fact is not None:
-            fleet.add(fact)
+        if fact is None:
+            continue
+        if verifier is not None:
+            why = _unverified(verifier, recorded, fact)
+            if why:
+                reading.unverified[recorded.topic] += 1
+                reading.unverified_why[why] += 1
+                continue
+        fleet.add(fact)
     reading.undecodable.update(unreadable)
     return fleet, reading
+
+
+def _unverified(verifier: Verifier, recorded: RecordedMessage, fact) -> str:
+    """Why the recorded message does not verify ('' if it does), its sender's name left out
+    so that a forger's many names make one reason."""
+    msg = recorded.message
+    if not hasattr(msg, 'auth'):
+        return 'not signed'
+    job_done = isinstance(fact, TaskEventFact) and fact.kind == EventKind.JOB_DONE
+    try:
+        why = verifier.check(msg, recorded.topic, signers_of(msg, job_done))
+    except (AttributeError, TypeError, ValueError):
+        return 'not signed'
+    return re.sub(r"'[^']*'", 'a sender', why.split(' (counter')[0])

@@ -2,15 +2,18 @@
 
 Rebuilds every mission of the recording from the messages alone (no ROS, no running fleet),
 prints what the recording holds, each mission's summary and story, and draws each mission's
-Gantt chart (with its data as JSON beside it) as the live monitor does. Exit code 0 when at
-least one mission was found, 1 when the file cannot be read or holds none, 2 for bad
-arguments.
+Gantt chart (with its data as JSON beside it) as the live monitor does. Given the fleet key
+(`--key-file`, else the file $FJSP_FLEET_KEY_FILE names), it believes only what verifies
+with it, as the fleet's nodes did, and says what it left out. Exit code 0 when at least one
+mission was found, 1 when the file cannot be read or holds none, 2 for bad arguments.
 """
 
 import argparse
+import os
 import sys
 from pathlib import Path
 
+from fjsp_common.auth import KEY_FILE_VARIABLE, FleetKeyError, read_key
 from fjsp_common.fleet import HEARTBEAT_TIMEOUT
 from fjsp_planner.observe import text, views
 from fjsp_planner.observe.mission_chart import write_mission
@@ -41,13 +44,22 @@ def parse(argv):
                         help='seconds without a robot state that count as offline '
                         f'(default {HEARTBEAT_TIMEOUT}, as the nodes)')
     parser.add_argument('--no-chart', action='store_true', help='print only, draw nothing')
+    parser.add_argument('--key-file', type=Path, default=None,
+                        help='fleet key to verify the messages with (default: '
+                        f'${KEY_FILE_VARIABLE}; none: every message is believed)')
     return parser.parse_args(argv)
 
 
 def main(argv=None) -> int:
     args = parse(sys.argv[1:] if argv is None else argv)
+    key_file = args.key_file or os.environ.get(KEY_FILE_VARIABLE) or None
     try:
-        fleet, reading = replay(args.recording, args.heartbeat_timeout)
+        key = read_key(key_file) if key_file else None
+    except FleetKeyError as error:
+        print(f'replay: {error}', file=sys.stderr)
+        return 2
+    try:
+        fleet, reading = replay(args.recording, args.heartbeat_timeout, key)
     except RecordingError as error:
         print(f'replay: {error}', file=sys.stderr)
         return 1
@@ -59,6 +71,17 @@ def main(argv=None) -> int:
     if reading.truncated:
         print(f'  the recording stops short (its recorder did not finish it): '
               f'{reading.truncated}')
+    for topic, count in sorted(reading.dropped_by_recorder.items()):
+        print(f'  {topic}: the recorder dropped {count} message(s) that did not verify with '
+              'the fleet key')
+    for topic, count in sorted(reading.unverified.items()):
+        print(f'  {topic}: {count} message(s) left out: they do not verify with the fleet key')
+    if reading.unverified:
+        print('  (' + '; '.join(f'{n} {why}' for why, n in reading.unverified_why.most_common())
+              + ')')
+    if key is None:
+        print('  not verified: no fleet key given (--key-file, or '
+              f'{KEY_FILE_VARIABLE}); every message is believed')
     missions = [m for m in fleet.missions.values() if m.plans or m.status is not None]
     if args.mission:
         missions = [m for m in missions if m.mission_id == args.mission]

@@ -324,6 +324,13 @@ class MissionController:
         return [Note(MissionEventKind.MISSION_STARTED,
                      (f'resumed after a planner restart {where}',))] + self.tick(wall)
 
+    def forget(self) -> 'Mission':
+        """Drop the running mission from memory, as a planner process that dies drops it
+        (its journal and the robots' histories bring it back: `resume`); the mission
+        dropped."""
+        mission, self.mission = self.mission, None
+        return mission
+
     def _resume_when_caught_up(self, mission, wall) -> list[Effect]:
         """Re-plan a resumed mission once what the robots did while no planner ran is known:
         every robot heard has had the latest task event it says it published received (a
@@ -374,6 +381,12 @@ class MissionController:
         if agent.offline_since is not None:
             return effects  # the tracker hears it again once it counts again
         return effects + self._record(mission, report, wall)
+
+    def unverified_state(self, robot: str, why: str, wall: float) -> None:
+        """A state about `robot` of the mission that does not verify with the fleet key
+        (`why`): not a heartbeat, but the reason its robot is named as silent."""
+        if self.mission is not None and robot in self.mission.tracker.robots:
+            self.liveness.refuse(robot, why, wall)
 
     def _record(self, mission: Mission, report: RobotReport, wall: float) -> list[Effect]:
         """Give the tracker a robot's report; the story of what changed."""
@@ -491,9 +504,11 @@ class MissionController:
                 continue
             if not change.back:
                 mission.tracker.mark_offline(change.robot, at=self._units(mission, wall))
-                effects.append(Note(MissionEventKind.ROBOT_OFFLINE,
-                                    (f'no state for {change.silent:.1f} s',),
-                                    robot=change.robot))
+                unverified = self.liveness.silenced(change.robot)
+                effects.append(Note(MissionEventKind.ROBOT_OFFLINE, (
+                    f'no state that verifies for {change.silent:.1f} s: {unverified}'
+                    if unverified else f'no state for {change.silent:.1f} s',),
+                    robot=change.robot))
             else:
                 report = self.liveness.agents[change.robot].report
                 effects.append(Note(MissionEventKind.ROBOT_BACK,
@@ -887,6 +902,8 @@ class MissionController:
         blocked = mission.blocked
         if mission.state == MissionState.WAITING_FOR_ROBOTS:
             blocked = tuple(f"waiting for robot '{r.name}' to report"
+                            + (f': its states do not verify: {unverified}'
+                               if (unverified := self.liveness.silenced(r.name)) else '')
                             for r in mission.problem.robots
                             if not self.liveness.heard(r.name))
         elif mission.state in (MissionState.FAILED, MissionState.CANCELLED):

@@ -5,9 +5,12 @@ failed nor offline, and it follows the plans it is given (an agent that refuses 
 for a robot type it cannot play, is left out and named in the warnings; so is one that keeps
 reporting an older revision than the latest, which it may never have received, until it
 reports the latest). A robot whose heartbeat is lost is offline until it has been heard again
-for a full heartbeat timeout, so that one late heartbeat does not re-plan twice.
+for a full heartbeat timeout, so that one late heartbeat does not re-plan twice. States that
+do not verify with the fleet key are no heartbeat, but they are remembered: a robot whose
+agent lacks the key is said to be unverified rather than merely silent.
 """
 
+import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -82,6 +85,8 @@ class Liveness:
         self.agents: dict[str, Agent] = {}
         self.events_heard: dict[str, RecentEvents] = {}
         """Per robot (of the mission, or heard from), the task events received from it."""
+        self.unverified: dict[str, tuple[str, float]] = {}
+        """Robot -> (why, when) of the latest state about it that did not verify."""
         self._last_tick: float | None = None
 
     def hear(self, report: RobotReport, wall: float) -> bool:
@@ -98,6 +103,17 @@ class Liveness:
                 agent.reachable_since = wall
             agent.report, agent.heard = report, wall
         return restarted
+
+    def refuse(self, robot: str, why: str, wall: float) -> None:
+        """A state about `robot` that does not verify with the fleet key (`why`) came."""
+        self.unverified[robot] = (why, wall)
+
+    def silenced(self, robot: str) -> str:
+        """Why the robot's latest states were dropped, if one came after the latest state
+        that verified ('' otherwise): it reports, but not with the fleet's key."""
+        why, at = self.unverified.get(robot, ('', -math.inf))
+        agent = self.agents.get(robot)
+        return why if agent is None or at > agent.heard else ''
 
     def hear_event(self, robot: str, event_id: str) -> None:
         self.events_heard.setdefault(robot, RecentEvents()).add(event_id)
@@ -142,7 +158,10 @@ class Liveness:
         why = {}
         for robot in mission.problem.robots:
             agent = self.agents.get(robot.name)
-            if agent is None:
+            unverified = self.silenced(robot.name)
+            if unverified and (agent is None or agent.offline_since is not None):
+                why[robot.name] = f'sends states that do not verify: {unverified}'
+            elif agent is None:
                 why[robot.name] = (f'has not reported since the mission was accepted '
                                    f'{wall - mission.accepted:.0f} s ago')
             elif agent.offline_since is not None:
