@@ -130,20 +130,25 @@ def subscription(node, topic: Topic, callback, **options):
 
     def take_all(msg) -> None:
         callback(msg)
-        sub = taking[0]
-        for _ in range(DRAIN):
-            try:
-                with sub.handle:
-                    taken = sub.handle.take_message(sub.msg_type, sub.raw)
-            except InvalidHandle:
-                return  # destroyed by the callback
-            if taken is None:
-                return
-            callback(taken[0])
+        take_waiting(taking[0], callback)
 
     sub = node.create_subscription(topic.type, topic.name, take_all, topic.qos, **options)
     taking.append(sub)
     return sub
+
+
+def take_waiting(sub, callback, limit: int = DRAIN) -> None:
+    """Hand `callback` the messages waiting in `sub`'s history, up to `limit`, without the
+    executor (a node stopping takes what arrived before it closes)."""
+    for _ in range(limit):
+        try:
+            with sub.handle:
+                taken = sub.handle.take_message(sub.msg_type, sub.raw)
+        except InvalidHandle:
+            return  # destroyed by the callback
+        if taken is None:
+            return
+        callback(taken[0])
 
 
 def _pair(vocabulary, message, prefix: str) -> tuple[dict, dict]:

@@ -23,7 +23,7 @@ from rclpy.qos import DurabilityPolicy, ReliabilityPolicy
 from rclpy.serialization import deserialize_message
 
 from fjsp_common.auth import NodeAuth, signers_of
-from fjsp_common.contract import TOPICS, subscription
+from fjsp_common.contract import TOPICS, subscription, take_waiting
 from fjsp_common.fleet import RECORDER_NODE
 from fjsp_common.parameters import ParameterSpec, table
 from fjsp_common.running import ParameterError, declare, run_node
@@ -145,6 +145,10 @@ class RecorderNode(Node):
                                 f'{error.strerror or error}')
 
     def destroy_node(self):
+        # Stopped (Ctrl-C, the launcher), it keeps what had arrived: a mission's last
+        # messages come just before it is stopped.
+        for sub in self.subscriptions:
+            take_waiting(sub, sub.callback)
         if not self.failed:
             try:
                 if self.dropped != self.noted:
