@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# The README's second command: build what is needed, lint, then run every test.
+# The README's second command: build what is needed, lint, then run every test. Arguments,
+# if any, are handed to one pytest run instead (e.g. `-m "not integration and not slow"`).
 set -euo pipefail
 
 WS="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
@@ -10,7 +11,16 @@ cd "$(dirname "$WS")"
 
 ruff check .
 status=0
-pytest test/ --durations=15 "$@" || status=$?
+if [[ $# -gt 0 ]]; then
+  pytest "$@" || status=$?
+else
+  # Fast DDS lists the network interfaces once per process: the tests across network
+  # namespaces run in a process of their own, before the others.
+  pytest test/integration/test_network_links.py --durations=5 || status=$?
+  # The rest on FJSP_TEST_WORKERS processes (pytest-xdist), a file per process at a time.
+  pytest test/ --ignore=test/integration/test_network_links.py \
+    -n "${FJSP_TEST_WORKERS:-2}" --dist loadfile --durations=15 || status=$?
+fi
 # pytest exits 5 when it collected nothing: for this suite that is a failure too.
 if [[ $status -eq 5 ]]; then
   echo "test.sh: pytest collected no tests" >&2
