@@ -48,7 +48,8 @@ def test_values_are_a_yaml_mapping(text, values):
 
 
 @pytest.mark.parametrize('text, error', [
-    ('{linear: [1}', 'are not valid YAML'),
+    ('{linear: [1}', 'are not read: YAML syntax error'),
+    ('{a: ' + '[' * 30000 + ']' * 30000 + '}', 'YAML nesting deeper than 64 levels'),
     ('[1, 2]', 'must be a YAML mapping'),
     ('3', 'must be a YAML mapping'),
 ])
@@ -198,7 +199,9 @@ def test_param_load_takes_the_node_section_and_on_request_the_wildcard(tmp_path)
      r"has no section for node '/planner' \(sections: /\*\*, monitor, agent_MARC1\)"),
     ('planner: 3\n', "section 'planner' needs a 'ros__parameters' mapping"),
     ('[1, 2]\n', "must map node names to 'ros__parameters'"),
-    ('planner: {ros__parameters: [1}\n', 'is not valid YAML'),
+    ('planner: {ros__parameters: [1}\n', 'is not read: YAML syntax error'),
+    ('planner: {ros__parameters: {x: ' + '[' * 30000 + ']' * 30000 + '}}\n',
+     'YAML nesting deeper than 64 levels'),
 ])
 def test_param_load_names_what_is_wrong_with_the_file(tmp_path, text, error):
     path = tmp_path / 'params.yaml'

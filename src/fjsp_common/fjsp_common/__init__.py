@@ -8,6 +8,8 @@ Free of ROS, so the domain core and tools use them too:
 - `revisions`: which attempt at a job a report is about, and whether it still counts;
 - `parameters`: a node parameter's one definition (`ParameterSpec`);
 - `decimals`: how every time a person reads is written (decimals, never raw fractions);
+- `bounded_yaml`: YAML read within limits of nesting, values and size, checked before
+  PyYAML builds anything (every YAML input of the project goes through it);
 - `wellformed`: what a plan or event must hold to be acted on (times that are numbers, a
   usable time scale), checked by every reader.
 

@@ -509,22 +509,29 @@ def _run(client: MissionClient, args) -> int:
     if args.verb == 'submit':
         shown = []
 
+        # Feedback comes on the client's thread: each line is printed whole, never into another.
+        printing = threading.Lock()
+
+        def say(text: str) -> None:
+            with printing:
+                print(text, flush=True)
+
         def show(feedback):
             line = describe_feedback(feedback)
             if args.wait and (not shown or line.split(', t=')[0] != shown[-1]):
                 shown.append(line.split(', t=')[0])
-                print(line, flush=True)
+                say(line)
 
         mission = client.submit(args.scenario, panels=args.panels, time_scale=args.time_scale,
                                 blocked_timeout=args.blocked_timeout,
                                 queue=not args.no_queue, feedback=show, timeout=args.timeout)
         position = mission.queue_position
-        print(f'mission {mission.mission_id} '
-              + (f'queued at position {position}' if position else 'started'), flush=True)
+        say(f'mission {mission.mission_id} '
+            + (f'queued at position {position}' if position else 'started'))
         if not args.wait:
             return 0
         result = mission.result(silence=args.timeout)
-        print(describe_result(result))
+        say(describe_result(result))
         return 0 if result.complete else 1
     if args.verb == 'cancel':
         print(client.cancel(args.mission, reason=args.reason, timeout=args.timeout))

@@ -20,6 +20,8 @@ from rosidl_parser.definition import (
     NamespacedType,
 )
 
+from fjsp_common.bounded_yaml import YamlError, load_yaml
+
 from .graph import CommandError
 
 KINDS = {'msg': 'message', 'srv': 'service', 'action': 'action'}
@@ -65,10 +67,9 @@ def interface_class(type_name: str, kind: str):
 def parse_values(text: str) -> dict:
     """The YAML mapping a user gave for a message, e.g. `{fault: 0, factor: 2.0}`."""
     try:
-        values = yaml.safe_load(text)
-    except yaml.YAMLError as error:
-        problem = getattr(error, 'problem', None) or str(error).splitlines()[0]
-        raise CommandError(f'values {text!r} are not valid YAML: {problem}') from None
+        values = load_yaml(text)
+    except YamlError as error:
+        raise CommandError(f'values {text[:200]!r} are not read: {error}') from None
     if values is None:
         return {}
     if not isinstance(values, dict):

@@ -9,6 +9,8 @@ from rcl_interfaces.msg import Parameter, ParameterType, ParameterValue
 from rclpy.parameter import PARAMETER_SEPARATOR_STRING, get_parameter_value
 from rclpy.parameter_client import AsyncParameterClient
 
+from fjsp_common.bounded_yaml import MAX_YAML_BYTES, YamlError, load_yaml
+
 from .graph import (
     LOOKUP_SPIN_TIME,
     CommandError,
@@ -93,13 +95,12 @@ def parameters_from_file(path: str, node: str, use_wildcard: bool) -> list[Param
     """The parameters a parameters file gives `node` (its section, keyed with or without the
     leading slash; with `use_wildcard` the `/**` section first), in file order."""
     try:
-        with open(path) as stream:
-            document = yaml.safe_load(stream)
+        with open(path, encoding='utf-8') as stream:
+            document = load_yaml(stream.read(MAX_YAML_BYTES + 1))
     except OSError as error:
         raise CommandError(f"cannot read parameters file '{path}': {error.strerror}") from None
-    except yaml.YAMLError as error:
-        raise CommandError(f"parameters file '{path}' is not valid YAML: "
-                           f'{getattr(error, "problem", error)}') from None
+    except (YamlError, UnicodeDecodeError) as error:
+        raise CommandError(f"parameters file '{path}' is not read: {error}") from None
     if not isinstance(document, dict):
         raise CommandError(f"parameters file '{path}' must map node names to "
                            "'ros__parameters'")

@@ -7,8 +7,7 @@ from pathlib import Path
 
 import yaml
 
-from fjsp_planner.model.bounded_yaml import load_yaml
-from fjsp_planner.model.limits import read_input_file
+from fjsp_planner.model.limits import load_yaml, read_input_file
 from fjsp_planner.model.problem import ProblemError
 
 

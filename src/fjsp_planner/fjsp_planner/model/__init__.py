@@ -4,8 +4,6 @@
 - `scenario`: YAML scenario files (docs/scenario-format.md) and N-panel repetition;
 - `fjs`: the classic FJSP benchmark text format;
 - `places`: locations on a map, and the Euclidean distances their coordinates imply;
-- `bounded_yaml`: YAML read within limits of nesting and alias expansion, checked before
-  PyYAML builds anything (every YAML input goes through it);
 - `extension`: jobs added to a running mission, as a scenario fragment;
 - `limits`: how large and how extreme an input may be, checked before anything is built;
 - `schedule`: `Schedule` (exact times) and the solver-neutral `Result`;

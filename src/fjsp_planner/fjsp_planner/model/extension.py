@@ -11,8 +11,7 @@ so such arcs are refused too.
 
 from collections.abc import Collection
 
-from fjsp_planner.model.bounded_yaml import load_yaml
-from fjsp_planner.model.limits import shown
+from fjsp_planner.model.limits import load_yaml, shown
 from fjsp_planner.model.problem import Problem, ProblemError
 from fjsp_planner.model.scenario import parse_scenario, problem_mapping
 

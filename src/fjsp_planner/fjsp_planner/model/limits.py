@@ -18,6 +18,7 @@ import stat
 from fractions import Fraction
 from pathlib import Path
 
+from fjsp_common import bounded_yaml
 from fjsp_common.decimals import decimal
 from fjsp_planner.model.problem import ProblemError
 
@@ -42,12 +43,6 @@ MAX_ARCS = 10_000
 """Precedence arcs, holding arcs, time overrides: each list."""
 MAX_NAME_LENGTH = 100
 MAX_FILE_BYTES = 4 * 2**20
-MAX_NESTING = 64
-"""Levels of YAML collections inside one another: a scenario needs six, a parameters file
-a few more per namespace; a YAML parser that recurses crashes on thousands."""
-MAX_YAML_VALUES = 2_000_000
-"""Values of one YAML text, each alias counted as what it names: a full distance table of
-1100 names is 1.2 million."""
 MAX_WORKERS = 64
 """More search workers than this only thrash on any machine the fleet's planner runs on, and
 CP-SAT rejects absurd counts with an opaque "model invalid"."""
@@ -120,6 +115,15 @@ def count_problem(what: str, count: int, limit: int, why: str = '') -> list[str]
     if count <= limit:
         return []
     return [f'{what}: {count} is more than the limit of {limit}' + (f' ({why})' if why else '')]
+
+
+def load_yaml(text: str, max_bytes: int = MAX_FILE_BYTES):
+    """The data of one YAML document, read within the bounds of `fjsp_common.bounded_yaml`
+    (nesting, values, size); ProblemError saying which it passes, and where."""
+    try:
+        return bounded_yaml.load_yaml(text, max_bytes)
+    except bounded_yaml.YamlError as error:
+        raise ProblemError([str(error)]) from None
 
 
 def read_input_file(path, kind: str) -> str:

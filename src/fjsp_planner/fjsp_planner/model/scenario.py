@@ -13,8 +13,7 @@ from pathlib import Path
 
 from fjsp_common.decimals import decimals
 from fjsp_planner.model import limits
-from fjsp_planner.model.bounded_yaml import load_yaml
-from fjsp_planner.model.limits import MAX_COORDINATE, MAX_TIME, shown
+from fjsp_planner.model.limits import MAX_COORDINATE, MAX_TIME, load_yaml, shown
 from fjsp_planner.model.places import euclidean_distances, on_grid, panel_coordinates
 from fjsp_planner.model.problem import Job, Problem, ProblemError, Robot, listed, suggestion
 

@@ -10,10 +10,20 @@ of aliases to aliases cannot make a billion values for the code that walks the r
 alias inside the collection it names (a structure containing itself) is refused.
 """
 
+import reprlib
+
 import yaml
 
-from fjsp_planner.model.limits import MAX_FILE_BYTES, MAX_NESTING, MAX_YAML_VALUES, shown
-from fjsp_planner.model.problem import ProblemError
+MAX_NESTING = 64
+"""Levels of YAML collections inside one another: a scenario needs six, a parameters file
+a few more per namespace; a YAML parser that recurses crashes on thousands."""
+MAX_YAML_VALUES = 2_000_000
+"""Values of one YAML text, each alias counted as what it names: a full distance table of
+1100 names is 1.2 million."""
+MAX_YAML_BYTES = 4 * 2**20
+
+_show = reprlib.Repr()
+_show.maxstring = _show.maxother = 200
 
 # The C parser is about five times faster on a large distance table.
 _LOADER = getattr(yaml, 'CSafeLoader', yaml.SafeLoader)
@@ -21,26 +31,30 @@ _OPENING = (yaml.MappingStartEvent, yaml.SequenceStartEvent)
 _CLOSING = (yaml.MappingEndEvent, yaml.SequenceEndEvent)
 
 
-def load_yaml(text: str, max_bytes: int = MAX_FILE_BYTES):
-    """The data of one YAML document, read with the safe loader; ProblemError saying what
+class YamlError(ValueError):
+    """Why a YAML text is not read: one line naming the limit or the error, and where."""
+
+
+def load_yaml(text: str, max_bytes: int = MAX_YAML_BYTES):
+    """The data of one YAML document, read with the safe loader; YamlError saying what
     makes it unreadable (a syntax error and where, a value that cannot be read, nesting deeper
     than MAX_NESTING, more than MAX_YAML_VALUES values once aliases are expanded, an alias
     inside what it names, more than `max_bytes` bytes of UTF-8)."""
     size = len(text.encode(errors='replace'))
     if size > max_bytes:
-        raise ProblemError([f'the YAML text has {size} bytes; at most {max_bytes} are read'])
+        raise YamlError(f'the YAML text has {size} bytes; at most {max_bytes} are read')
     try:
         _check_bounds(text)
         return yaml.load(text, Loader=_LOADER)  # noqa: S506 - a safe loader
-    except ProblemError:
+    except YamlError:
         raise
     except yaml.YAMLError as error:
         mark = getattr(error, 'problem_mark', None)
         reason = getattr(error, 'problem', None) or str(error)
-        raise ProblemError([f'YAML syntax error at {_where(mark)}: {reason}']) from None
+        raise YamlError(f'YAML syntax error at {_where(mark)}: {reason}') from None
     except (ValueError, OverflowError) as error:
         # e.g. an integer of more than 4300 digits, or a date that does not exist
-        raise ProblemError([f'YAML value that cannot be read: {shown(str(error))}']) from None
+        raise YamlError(f'YAML value that cannot be read: {_show.repr(str(error))}') from None
 
 
 def _where(mark) -> str:
@@ -57,7 +71,7 @@ class _Open:
 
 
 def _check_bounds(text: str) -> None:
-    """ProblemError at the first event beyond a limit; nothing is built."""
+    """YamlError at the first event beyond a limit; nothing is built."""
     open_ = [_Open(None, 0, 0)]
     sizes: dict[str, tuple[int, int]] = {}
     """Anchor -> (values, levels) of what it names."""
@@ -69,8 +83,8 @@ def _check_bounds(text: str) -> None:
             depth = open_[-1].depth + (kind in _OPENING)
             if kind in _OPENING:
                 if depth > MAX_NESTING:
-                    raise ProblemError([f'YAML nesting deeper than {MAX_NESTING} levels at '
-                                        f'{_where(event.start_mark)}'])
+                    raise YamlError(f'YAML nesting deeper than {MAX_NESTING} levels at '
+                                    f'{_where(event.start_mark)}')
                 open_.append(_Open(event.anchor, depth, values))
             elif event.anchor:
                 sizes[event.anchor] = (1, 0)
@@ -83,19 +97,19 @@ def _check_bounds(text: str) -> None:
             open_[-1].deepest = max(open_[-1].deepest, closed.deepest)
         elif kind is yaml.AliasEvent:
             if any(o.anchor == event.anchor for o in open_):
-                raise ProblemError([f'YAML alias *{event.anchor[:80]} at '
-                                    f'{_where(event.start_mark)} is inside what it names: a '
-                                    'structure cannot contain itself'])
+                raise YamlError(f'YAML alias *{event.anchor[:80]} at '
+                                f'{_where(event.start_mark)} is inside what it names: a '
+                                'structure cannot contain itself')
             count, levels = sizes.get(event.anchor, (1, 0))
             values += count
             depth = open_[-1].depth + levels
             if depth > MAX_NESTING:
-                raise ProblemError([f'YAML nesting deeper than {MAX_NESTING} levels (through '
-                                    f'alias *{event.anchor[:80]}) at '
-                                    f'{_where(event.start_mark)}'])
+                raise YamlError(f'YAML nesting deeper than {MAX_NESTING} levels (through '
+                                f'alias *{event.anchor[:80]}) at '
+                                f'{_where(event.start_mark)}')
             open_[-1].deepest = max(open_[-1].deepest, depth)
         else:
             continue
         if values > MAX_YAML_VALUES:
-            raise ProblemError([f'YAML of more than {MAX_YAML_VALUES} values (aliases '
-                                f'counted as what they name) at {_where(event.start_mark)}'])
+            raise YamlError(f'YAML of more than {MAX_YAML_VALUES} values (aliases '
+                            f'counted as what they name) at {_where(event.start_mark)}')

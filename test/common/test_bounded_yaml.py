@@ -5,9 +5,9 @@ within the bounds reads as PyYAML reads it."""
 import pytest
 import yaml
 
-from fjsp_planner.model.bounded_yaml import load_yaml
+from fjsp_common.bounded_yaml import MAX_NESTING, MAX_YAML_VALUES
 from fjsp_planner.model.extension import extend
-from fjsp_planner.model.limits import MAX_NESTING, MAX_YAML_VALUES
+from fjsp_planner.model.limits import load_yaml
 from fjsp_planner.model.problem import ProblemError
 from fjsp_planner.model.scenario import ScenarioError, load_scenario, scenario_from_text
 
