@@ -236,12 +236,14 @@ def test_solve_reports_panel_bounds_on_two_panels():
     load (the machine bound's 91 1/3 takes about 3 s on an idle machine; its value is
     checked above without a deadline), so this asserts only what is computed without
     search: the decomposition bounds' 58, far above CP-SAT's own 49, below a valid schedule
-    no longer than the greedy one."""
+    no longer than the first greedy pass (the randomised passes after it get fewer tries in
+    a loaded solve than alone)."""
     problem = load_scenario(PAPER, panels=2)
     result = solve(problem, time_limit=3)
     assert result.status in (Status.FEASIBLE, Status.OPTIMAL)
     assert validate(problem, result.schedule) == []
-    assert 58 <= result.lower_bound <= result.makespan <= greedy_schedule(problem).makespan
+    first_pass = greedy_schedule(problem, passes=1)
+    assert 58 <= result.lower_bound <= result.makespan <= first_pass.makespan
     assert any('panel decomposition' in note for note in result.notes), result.notes
 
 
