@@ -5,8 +5,10 @@ import dataclasses
 from fractions import Fraction
 
 from fjsp_planner.model.problem import FixedJob, Job, Problem, Robot
+from fjsp_planner.model.schedule import Status
 from fjsp_planner.solving.bounds.assignment import fleet_load_bound
 from fjsp_planner.solving.bounds.fleet import static_bound
+from fjsp_planner.solving.cpsat import solve_cpsat
 from fjsp_planner.solving.solve import solve
 
 
@@ -62,3 +64,14 @@ def test_running_jobs_get_none():
     running = dataclasses.replace(problem, fixed={
         'x': FixedJob(0, Fraction(0), Fraction(2), {'W': 1})})
     assert fleet_load_bound(running, 5) is None
+
+
+def test_cpsat_given_the_bound_stops_when_a_schedule_meets_it():
+    """The three-jobs-at-a case, the fleet load bound 6 given: CP-SAT's schedule of 6 is
+    proven optimal, the bound kept as the model's floor (a floor above the optimum would
+    make the model infeasible, one rounded wrongly a bound of 6 - 1 tick)."""
+    problem = welders([Robot('W1', 'Welder', start_location='a'),
+                       Robot('W2', 'Welder', start_location='b')],
+                      [('x1', 'a'), ('x2', 'a'), ('x3', 'a'), ('y', 'b')])
+    result = solve_cpsat(problem, 5, 1, lower_bound=fleet_load_bound(problem, 5))
+    assert result.status == Status.OPTIMAL and result.makespan == result.lower_bound == 6
