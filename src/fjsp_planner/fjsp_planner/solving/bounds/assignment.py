@@ -17,7 +17,8 @@ from fractions import Fraction
 from ortools.sat.python import cp_model
 
 from fjsp_planner.model.problem import Problem
-from fjsp_planner.solving.bounds.jobs import staffings
+from fjsp_planner.solving.bounds.geometry import least_leg_into
+from fjsp_planner.solving.bounds.jobs import fastest_sets
 
 MAX_GRID = 1000
 MAX_CHOICES = 20_000
@@ -32,16 +33,16 @@ def fleet_load_bound(problem: Problem, time_limit: float, workers: int = 1,
     makespan known to be reachable, it never exceeds that."""
     if problem.fixed or not problem.jobs:
         return None
+    robots = sorted(r.name for r in problem.robots)
     choices = {}
     count = 0
     for job in problem.jobs:
-        choices[job.name] = _choices(problem, job.plans)
+        choices[job.name] = fastest_sets(problem, job.plans, robots)
         count += len(choices[job.name])
         if count > MAX_CHOICES:
             return None
-    robots = [r.name for r in problem.robots]
     places = {job.location for job in problem.jobs}
-    legs = {(r, place): _least_leg_into(problem, r, place) for r in robots for place in places}
+    legs = {(r, place): least_leg_into(problem, r, place) for r in robots for place in places}
     entries = {(r.name, place): problem.travel(r.name, r.start_location, place)
                for r in problem.robots if r.start_location is not None for place in places}
     values = [d for found in choices.values() for d, _ in found]
@@ -103,28 +104,3 @@ def fleet_load_bound(problem: Problem, time_limit: float, workers: int = 1,
         return None
     found = Fraction(math.ceil(solver.best_objective_bound), scale)
     return found if incumbent is None else min(found, incumbent)
-
-
-def _choices(problem: Problem, plans) -> list[tuple[Fraction, tuple[str, ...]]]:
-    """[(least duration, robot set)] of a job: a set is kept only if no smaller set is as
-    fast (it would load more robots for nothing)."""
-    robots = sorted(r.name for r in problem.robots)
-    fastest = {}
-    for plan in plans:
-        for staffing in staffings(problem, plan, robots):
-            key = frozenset(r for r, _ in staffing)
-            length = max(problem.duration(r, q) for r, q in staffing)
-            fastest[key] = min(length, fastest.get(key, length))
-    return sorted((d, tuple(sorted(s))) for s, d in fastest.items()
-                  if not any(o < s and fastest[o] <= d for o in fastest))
-
-
-def _least_leg_into(problem: Problem, robot: str, place: str) -> Fraction:
-    """Least time for the robot to reach `place` from any other place it could be at."""
-    sources = {job.location for job in problem.jobs}
-    start = problem.robot(robot).start_location
-    if start is not None:
-        sources.add(start)
-    sources.discard(place)
-    return min((problem.travel(robot, source, place) for source in sources),
-               default=Fraction(0))
