@@ -70,7 +70,7 @@ def _entries():
         yield KnownOptimum(f'slow crossers {seed} x3',
                            partial(inst.slow_crossers, seed, Fraction(crossing), 3, shift,
                                    mover_too),
-                           Fraction(optimum), ('cpsat',), 60)
+                           Fraction(optimum), ('cpsat',), 120)
     for slow_hold in (1, 6):
         yield KnownOptimum(f'unrelated {slow_hold}', partial(inst.unrelated, slow_hold),
                            Fraction(6), ('cpsat',), 20)
