@@ -1,7 +1,7 @@
-"""The scenarios shipped in config/scenarios/ besides the paper's: they load, and CP-SAT
-proves their optimum (the values their files state) with a schedule the validator accepts.
-The integration tests run them on the node network; this is where a broken file shows first.
-"""
+"""The table of known optima (`known_optima`): every bound stays at or below each entry,
+checked without solving, and one slow test proves every entry again with each of its
+provers. Also: the scenarios shipped in config/scenarios/ besides the paper's carry the
+features the integration tests rely on."""
 
 from fractions import Fraction
 
@@ -10,25 +10,63 @@ import pytest
 from fjsp_planner.model.scenario import load_scenario
 from fjsp_planner.model.schedule import Status
 from fjsp_planner.model.validate import validate
+from fjsp_planner.solving.bounds import panel
+from fjsp_planner.solving.bounds.assignment import fleet_load_bound
+from fjsp_planner.solving.bounds.fleet import static_bound
+from fjsp_planner.solving.bounds.load import panel_load_bound
+from fjsp_planner.solving.bounds.machine import panel_machine_bound
+from fjsp_planner.solving.bounds.sequence import panel_sequence_bound
 from fjsp_planner.solving.solve import solve
 
+from known_optima import KNOWN
 from repo_paths import SCENARIOS
 
 
-@pytest.mark.parametrize(('scenario', 'optimum'), [
-    ('truss.yaml', Fraction(23)),
-    ('antenna.yaml', Fraction(88, 5)),
-    ('habitat.yaml', Fraction(58)),
-])
-def test_shipped_scenario_is_proven_optimal(scenario, optimum):
-    problem = load_scenario(SCENARIOS / scenario)
-    assert any(r.start_location for r in problem.robots)
-    assert any(r.release_time > 0 for r in problem.robots)
-    assert any(len(j.plans) > 1 for j in problem.jobs) and problem.holding
-    result = solve(problem, time_limit=60, workers=2)
-    assert result.status == Status.OPTIMAL, result
-    assert result.makespan == optimum
-    assert validate(problem, result.schedule) == []
+@pytest.mark.slow
+@pytest.mark.parametrize('name', list(KNOWN))
+def test_every_known_optimum_is_proven_again_by_each_of_its_provers(name):
+    """The MIP has none of the CP-SAT cuts: where both prove the entry, no cut removed an
+    optimal schedule."""
+    entry = KNOWN[name]
+    problem = entry.problem()
+    for prover in entry.provers:
+        if prover == 'mip':
+            result = solve(problem, solver='mip', mip_backend='SCIP',
+                           time_limit=entry.time_limit, workers=1)
+        else:
+            result = solve(problem, time_limit=entry.time_limit, workers=2)
+        assert result.status == Status.OPTIMAL, (prover, result)
+        assert result.makespan == result.lower_bound == entry.optimum, prover
+        assert validate(problem, result.schedule) == [], prover
+
+
+@pytest.mark.parametrize('name', list(KNOWN))
+def test_every_bound_stays_at_or_below_the_known_optimum(name):
+    """The static and fleet load bounds on every entry; on panels, the panel bounds too,
+    given a schedule just above the optimum (as the search would report one)."""
+    entry = KNOWN[name]
+    problem = entry.problem()
+    assert static_bound(problem) <= entry.optimum
+    load = fleet_load_bound(problem, 10)
+    assert load is None or load <= entry.optimum, 'fleet load'
+    if not problem.panels:
+        return
+    incumbent = entry.optimum + 1
+    for bound, found in [
+            ('machine', panel_machine_bound(problem, incumbent, 30)),
+            ('load', panel_load_bound(problem, incumbent, 30)),
+            ('sequence', panel_sequence_bound(problem, incumbent, 30)),
+            ('energy', panel.panel_energy_bound(problem, incumbent)),
+            ('clique', panel.panel_clique_bound(problem, incumbent))]:
+        assert found is None or found <= entry.optimum, bound
+
+
+def test_the_shipped_scenarios_carry_start_locations_releases_plans_and_holding():
+    for scenario in ('truss', 'antenna', 'habitat'):
+        problem = load_scenario(SCENARIOS / f'{scenario}.yaml')
+        assert any(r.start_location for r in problem.robots), scenario
+        assert any(r.release_time > 0 for r in problem.robots), scenario
+        assert any(len(j.plans) > 1 for j in problem.jobs) and problem.holding, scenario
 
 
 def test_the_yard_map_is_planned_to_its_optimum_on_the_solver_grid():

@@ -24,7 +24,7 @@ def test_jobs_move_from_a_slow_robot_to_a_fast_one():
                       'y': JobAssignment('y', 0, Fraction(5), Fraction(10), {'A': 1})},
                      {'A': ('x', 'y'), 'B': ()})
     assert validate(problem, start) == []
-    found, _ = local_search(problem, start, time.monotonic() + 2)
+    found, _ = local_search(problem, start, time.monotonic() + 1)
     assert validate(problem, found) == []
     assert found.makespan == 2
 
@@ -35,6 +35,6 @@ def test_generated_scenarios_stay_valid_and_no_longer():
     for seed in (1, 2, 3):
         problem = parse_scenario(random_scenario(seed, Shape(jobs=30, robots=5)))
         start = greedy_schedule(problem)
-        found, _ = local_search(problem, start, time.monotonic() + 1, seed=seed)
+        found, _ = local_search(problem, start, time.monotonic() + 0.5, seed=seed)
         assert validate(problem, found) == []
         assert found.makespan <= start.makespan

@@ -1,15 +1,11 @@
 """Bounds for any scenario (`bounds.fleet`) and the CP-SAT cut that counts each robot's work
-and travel: each checked by hand on small cases, then against optima proven independently."""
+and travel, checked by hand on small cases. Against optima proven independently (generated
+scenarios the MIP and CP-SAT both prove): `test_known_optima.py`."""
 
 from fractions import Fraction
 
-import pytest
-
-from fjsp_planner.model.generator import Shape, random_scenario
 from fjsp_planner.model.problem import Job, Problem, Robot
-from fjsp_planner.model.scenario import parse_scenario
-from fjsp_planner.model.schedule import Status
-from fjsp_planner.solving.bounds.fleet import _Facts, fleet_bound, static_bound
+from fjsp_planner.solving.bounds.fleet import _Facts, fleet_bound
 from fjsp_planner.solving.solve import solve
 
 OPS = {0: 'hold', 1: 'weld', 2: 'move'}
@@ -53,25 +49,3 @@ def test_a_job_starts_no_earlier_than_its_robots_can_arrive():
                         [Job('x', 'b', ((0,),)), Job('y', 'b', ((1,),))], [('x', 'y')])
     assert _Facts(problem).chain_bound() == 15
     assert solve(problem).makespan == 15
-
-
-@pytest.mark.slow
-@pytest.mark.parametrize('seed', range(400, 408))
-def test_cpsat_and_the_mip_prove_the_same_optimum_above_the_static_bound(seed):
-    """The MIP shares nothing with the CP-SAT model and its cuts: the same optimum from both
-    says no cut removed an optimal schedule, and the static bound stays below it."""
-    problem = parse_scenario(random_scenario(seed, Shape(jobs=5, robots=3, robot_types=2)))
-    mip = solve(problem, solver='mip', time_limit=60)
-    cpsat = solve(problem, time_limit=30)
-    assert mip.status == cpsat.status == Status.OPTIMAL
-    assert mip.makespan == cpsat.makespan
-    assert static_bound(problem) <= cpsat.makespan
-
-
-@pytest.mark.slow
-def test_the_static_bound_stays_below_proven_optima_of_generated_scenarios():
-    for seed in range(300, 330):
-        problem = parse_scenario(random_scenario(seed, Shape(jobs=7, robots=4, robot_types=3)))
-        result = solve(problem, time_limit=20)
-        if result.status == Status.OPTIMAL:
-            assert static_bound(problem) <= result.makespan, f'seed {seed}'

@@ -2,21 +2,27 @@
 search side by side, from the start (docs/solver.md, "Local search").
 
 CP-SAT runs in a thread of its own from the start's schedule, for its bound and its own
-improvements; the local search (`local`) runs meanwhile from the same schedule. The shorter
-schedule wins; the bound is CP-SAT's, no weaker than the static bound.
+improvements; the local search (`local`) runs meanwhile from the same schedule, and the
+fleet load bound (`bounds.assignment`) in a thread of its own for a short share of the
+limit. The shorter schedule wins; the bound is the best of CP-SAT's, the static bound and
+the fleet load bound.
 """
 
 import time
 
 from fjsp_planner.model.problem import Problem
 from fjsp_planner.model.schedule import Result, Status
-from fjsp_planner.solving.beside import CpsatBeside
+from fjsp_planner.solving.beside import Beside, CpsatBeside
+from fjsp_planner.solving.bounds.assignment import fleet_load_bound
 from fjsp_planner.solving.bounds.fleet import static_bound
 from fjsp_planner.solving.local import local_search
 from fjsp_planner.solving.start import Start
 
 MIN_JOBS = 25
 """Up to this many jobs CP-SAT usually proves the optimum in seconds with both cores."""
+LOAD_BOUND_SHARE = 0.05
+"""Share of the time limit for the fleet load bound, on one core beside the search: it
+comes within 1 % of its optimum in about a second on 120 jobs."""
 
 
 def applies(problem: Problem, start: Start, keep) -> bool:
@@ -33,6 +39,8 @@ def solve_routed(problem: Problem, start: Start, began: float, time_limit: float
     first = start.best
     setup = time.monotonic() - began
     search = CpsatBeside(problem, deadline, workers, first, start.hint or first, log)
+    load = Beside('fleet load bound', lambda: fleet_load_bound(
+        problem, LOAD_BOUND_SHARE * time_limit, incumbent=first.makespan))
     best, best_at = local_search(problem, first, deadline, stop=search.done)
     solver = 'local search' if best is not first else 'greedy'
     result = search.result()
@@ -41,7 +49,8 @@ def solve_routed(problem: Problem, start: Start, began: float, time_limit: float
     if result.schedule is not None and result.makespan < best.makespan:
         best, solver = result.schedule, 'cpsat'
         best_at = search.started + (result.best_solution_seconds or result.solve_seconds)
-    bound = min(max(result.lower_bound or 0, static_bound(problem)), best.makespan)
+    bound = min(max(result.lower_bound or 0, static_bound(problem), load.result() or 0),
+                best.makespan)
     return Result(Status.OPTIMAL if bound >= best.makespan else Status.FEASIBLE,
                   best.makespan, bound, time.monotonic() - began, best, solver,
                   first_solution_seconds=setup, best_solution_seconds=max(best_at - began,

@@ -5,6 +5,8 @@
 - `jobs`: staffings, precedence order, heads and tails, and the critical path bound;
 - `fleet`: bounds for any scenario from what the fleet must do: chains from the robots'
   arrival, energy over capability groups, a robot alone with its travel;
+- `assignment`: the "fleet load" bound for any scenario, each robot's work and travel
+  with the staffing of every job chosen by CP-SAT;
 - `panel`: the panel decomposition bounds for identical panels (energy, clique) and the
   panel limits of robots slow to move between panels;
 - `machine`: the "panel machine" relaxation CP-SAT solves to optimality;

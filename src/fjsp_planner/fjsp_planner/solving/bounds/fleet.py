@@ -26,6 +26,7 @@ schedule, so each holds for every schedule. Problems with running (fixed) jobs g
 from fractions import Fraction
 
 from fjsp_planner.model.problem import Problem, max_staffed
+from fjsp_planner.solving.bounds.geometry import least_leg_into
 from fjsp_planner.solving.bounds.jobs import critical_path_bound, topological
 
 
@@ -159,7 +160,7 @@ class _Facts:
             lengths = {job.name: min(length for count, length in self.needed(alone, job)
                                      if count >= 1) for job in mine}
             places = {job.location for job in mine} - {robot.start_location}
-            legs = [self._least_leg_into(r, place) for place in places]
+            legs = [least_leg_into(p, r, place) for place in places]
             # A robot that may start anywhere needs no leg into its first place.
             moves = sum(legs) - (max(legs, default=0) if robot.start_location is None else 0)
             best = max(best, robot.release_time + sum(lengths.values()) + moves)
@@ -168,17 +169,6 @@ class _Facts:
                 best = max(best, head + sum(lengths[j] for j in later)
                            + min(self.tails[j] for j in later))
         return best
-
-    def _least_leg_into(self, robot: str, place: str) -> Fraction:
-        """Least time for the robot to reach `place` from any other place it could be at."""
-        p = self.problem
-        sources = {job.location for job in p.jobs}
-        start = p.robot(robot).start_location
-        if start is not None:
-            sources.add(start)
-        sources.discard(place)
-        return min((p.travel(robot, source, place) for source in sources),
-                   default=Fraction(0))
 
 
 def _least_time_holding(energy: Fraction, ready: list[Fraction]) -> Fraction:

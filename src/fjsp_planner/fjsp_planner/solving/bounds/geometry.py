@@ -145,3 +145,16 @@ def panel_paths(problem: Problem) -> dict[bool, dict[tuple[str, str], Fraction]]
                   True: {(names[i], names[j]): found for (i, j), found in across.items()}}
         object.__setattr__(problem, '_panel_paths', cached)
     return cached
+
+
+def least_leg_into(problem: Problem, robot: str, place: str) -> Fraction:
+    """Least time for the robot to reach `place` from any other place it could be at (a job's
+    location or its start location): a robot goes straight from one job to the next, so it
+    enters a place it works at, other than where it starts, by such a leg."""
+    sources = {job.location for job in problem.jobs}
+    start = problem.robot(robot).start_location
+    if start is not None:
+        sources.add(start)
+    sources.discard(place)
+    return min((problem.travel(robot, source, place) for source in sources),
+               default=Fraction(0))

@@ -40,6 +40,20 @@ def staffings(problem: Problem, plan, robots):
             yield staffing
 
 
+def fastest_sets(problem: Problem, plans, robots) -> list[tuple[Fraction, tuple[str, ...]]]:
+    """[(least duration, robot set)] of a job with `plans`, staffed from `robots`, shortest
+    first: a set is kept only if no smaller set is as fast (it would load more robots for
+    nothing)."""
+    fastest = {}
+    for plan in plans:
+        for staffing in staffings(problem, plan, robots):
+            key = frozenset(r for r, _ in staffing)
+            length = max(problem.duration(r, q) for r, q in staffing)
+            fastest[key] = min(length, fastest.get(key, length))
+    return sorted((d, tuple(sorted(s))) for s, d in fastest.items()
+                  if not any(o < s and fastest[o] <= d for o in fastest))
+
+
 def topological(problem: Problem) -> list[str]:
     """The jobs, each after every job that must complete before it."""
     before = problem.ancestors()

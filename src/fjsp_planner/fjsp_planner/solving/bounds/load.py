@@ -37,7 +37,7 @@ from ortools.sat.python import cp_model
 
 from fjsp_planner.model.problem import Problem
 from fjsp_planner.solving.bounds.geometry import panel_distance, travel_factor
-from fjsp_planner.solving.bounds.jobs import heads_and_tails, staffings
+from fjsp_planner.solving.bounds.jobs import fastest_sets, heads_and_tails
 from fjsp_planner.solving.bounds.machine import BOUND_SUBSOLVERS
 from fjsp_planner.solving.bounds.panel import panel_limits
 
@@ -253,14 +253,7 @@ def _choices(problem: Problem, incumbent: Fraction):
 
 
 def _fitting(problem, plans, robots, around, incumbent):
-    fastest = {}
-    for plan in plans:
-        for staffing in staffings(problem, plan, robots):
-            key = frozenset(r for r, _ in staffing)
-            length = max(problem.duration(r, q) for r, q in staffing)
-            fastest[key] = min(length, fastest.get(key, length))
-    found = sorted((d, tuple(sorted(s))) for s, d in fastest.items()
-                   if not any(o < s and fastest[o] <= d for o in fastest))
+    found = fastest_sets(problem, plans, robots)
     return [(d, s) for d, s in found if around + d < incumbent] or found[:1]
 
 

@@ -46,11 +46,13 @@ class SearchHandle:
 
 def solve_cpsat(problem: Problem, time_limit=10.0, workers=2, hint: Schedule | None = None,
                 keep: Schedule | None = None, upper_bound: Schedule | None = None,
-                log=False, handle: SearchHandle | None = None) -> Result:
+                log=False, handle: SearchHandle | None = None,
+                lower_bound: Fraction | None = None) -> Result:
     """Minimise the makespan; with `keep`, then prefer `keep`'s (job, robot) assignments.
 
     `upper_bound` is a valid schedule (e.g. greedy) that sets the horizon and, on models with
-    routes, is hinted unless `hint` is given. The whole call, model building
+    routes, is hinted unless `hint` is given. `lower_bound`, a bound proven elsewhere, lets
+    the search stop as soon as it reaches it. The whole call, model building
     included, ends within `time_limit` seconds (plus CP-SAT's reaction time to its limit).
     `handle` lets another thread see the best makespan so far and stop the search early.
     """
@@ -66,6 +68,8 @@ def solve_cpsat(problem: Problem, time_limit=10.0, workers=2, hint: Schedule | N
     except OutOfTimeError:
         return Result(Status.UNKNOWN, None, None, time.monotonic() - began, None, 'cpsat',
                       notes=(f'building the CP-SAT model took the whole {time_limit:g} s',))
+    if lower_bound is not None:
+        model.model.add(model.makespan >= model.grid.floor(lower_bound))
     model.minimize_makespan()
     setup = time.monotonic() - began
     solver, recorder, status = run(model.model, deadline - time.monotonic(), workers, log,

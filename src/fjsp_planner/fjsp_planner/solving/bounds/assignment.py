@@ -1,0 +1,106 @@
+"""A lower bound for any scenario from what each robot must do and travel: the "fleet load"
+bound (docs/solver.md, "Bounds").
+
+Every robot is busy for the whole of each job it works on, and it enters each place it
+works at, other than its start location, by a leg no shorter than the least into that place
+from any other (a robot that may start anywhere enters its first place for free). So its
+release time, the durations of its jobs and those legs fit in the makespan, whatever the
+order. CP-SAT chooses every job's staffing (a set of robots, at the least duration that set
+achieves) to minimise the largest such sum; `bounds.fleet` counts the same per robot only
+for the jobs nobody else can do, and the work of a group without its travel. Times are
+floored onto a grid, which only lowers the bound.
+"""
+
+import math
+from fractions import Fraction
+
+from ortools.sat.python import cp_model
+
+from fjsp_planner.model.problem import Problem
+from fjsp_planner.solving.bounds.geometry import least_leg_into
+from fjsp_planner.solving.bounds.jobs import fastest_sets
+
+MAX_GRID = 1000
+MAX_CHOICES = 20_000
+"""Staffing literals beyond which building the model alone would take seconds; large fleets
+go without this bound."""
+
+
+def fleet_load_bound(problem: Problem, time_limit: float, workers: int = 1,
+                     incumbent: Fraction | None = None) -> Fraction | None:
+    """The bound of the module docstring, or None when it does not apply (running jobs, too
+    many staffings) or CP-SAT proves nothing in `time_limit` seconds. With `incumbent`, a
+    makespan known to be reachable, it never exceeds that."""
+    if problem.fixed or not problem.jobs:
+        return None
+    robots = sorted(r.name for r in problem.robots)
+    choices = {}
+    count = 0
+    for job in problem.jobs:
+        choices[job.name] = fastest_sets(problem, job.plans, robots)
+        count += len(choices[job.name])
+        if count > MAX_CHOICES:
+            return None
+    places = {job.location for job in problem.jobs}
+    legs = {(r, place): least_leg_into(problem, r, place) for r in robots for place in places}
+    entries = {(r.name, place): problem.travel(r.name, r.start_location, place)
+               for r in problem.robots if r.start_location is not None for place in places}
+    values = [d for found in choices.values() for d, _ in found]
+    values += [r.release_time for r in problem.robots] + list(legs.values())
+    values += list(entries.values())
+    scale = min(MAX_GRID, math.lcm(*(v.denominator for v in values)))
+
+    def ticks(value: Fraction) -> int:
+        return value.numerator * scale // value.denominator
+
+    horizon = sum(max(ticks(d) for d, _ in found) for found in choices.values())
+    horizon += max(ticks(r.release_time) for r in problem.robots) + max(
+        map(ticks, entries.values()), default=0) + sum(map(ticks, legs.values()))
+    m = cp_model.CpModel()
+    makespan = m.new_int_var(0, horizon, 'makespan')
+    load = {r: [] for r in robots}
+    works = {}
+    """(robot, place) -> the literals of the choices that have the robot work there."""
+    for job in problem.jobs:
+        found = choices[job.name]
+        picks = [m.new_bool_var(f'pick_{job.name}_{i}') for i in range(len(found))]
+        m.add_exactly_one(picks)
+        for pick, (duration, members) in zip(picks, found, strict=True):
+            for r in members:
+                load[r].append(pick * ticks(duration))
+                works.setdefault((r, job.location), []).append(pick)
+    for robot in problem.robots:
+        r = robot.name
+        visits, firsts, travel = [], [], []
+        for (who, place), picks in sorted(works.items()):
+            if who != r:
+                continue
+            visit = m.new_bool_var(f'visits_{place}_{r}')
+            for pick in picks:
+                m.add_implication(pick, visit)
+            first = m.new_bool_var(f'first_{place}_{r}')
+            m.add_implication(first, visit)
+            visits.append(visit)
+            firsts.append(first)
+            # The first place is entered from the start location (from nowhere without
+            # one), every other place by at least its least leg.
+            entry = entries.get((r, place), Fraction(0))
+            travel.append(visit * ticks(legs[r, place])
+                          + first * (ticks(entry) - ticks(legs[r, place])))
+        if not visits:
+            continue
+        m.add_at_most_one(firsts)
+        for visit in visits:
+            m.add(sum(firsts) >= visit)
+        m.add(makespan >= sum(load[r]) + sum(travel) + ticks(robot.release_time))
+    m.minimize(makespan)
+    solver = cp_model.CpSolver()
+    solver.parameters.max_time_in_seconds = max(0.01, time_limit)
+    solver.parameters.num_workers = workers
+    solver.parameters.catch_sigint_signal = False
+    status = solver.solve(m).name
+    if status in ('MODEL_INVALID', 'INFEASIBLE') or not math.isfinite(
+            solver.best_objective_bound):
+        return None
+    found = Fraction(math.ceil(solver.best_objective_bound), scale)
+    return found if incumbent is None else min(found, incumbent)
