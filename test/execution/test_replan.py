@@ -417,6 +417,19 @@ def test_a_slow_leg_releases_the_robot_no_earlier_than_its_reported_arrival_allo
     assert posed.robot('R').release_time == 6
 
 
+def test_a_robot_not_yet_released_stays_unreleased_on_its_leg():
+    """R is released at 10 at a; at 3 it stands at the start of its first leg, toward X at b
+    (10 away), which the tracker reckons it could end at 13. It still cannot leave before
+    10. Found by a generated fleet whose robot failed and recovered before its release: the
+    re-plan let it leave at once, and its first job started before it could have arrived."""
+    problem = crossroads()
+    problem = replace(problem, robots=(replace(problem.robot('R'), release_time=Fraction(10)),))
+    state = ExecutionState(Fraction(3), frozenset(), {}, {
+        'R': RobotSituation('R', True, 'b', Fraction(13), on_way=Waypoint('a', 'b', Fraction(0)))})
+    posed = residual_problem(problem, state, PLAN_XY).problem
+    assert (posed.robot('R').start_location, posed.robot('R').release_time) == ('a', 10)
+
+
 @pytest.fixture(scope='module')
 def paper():
     problem = load_scenario(PAPER)

@@ -556,7 +556,9 @@ def _pose(problem, state, healthy, todo, fixed, kept, began, carried_to, aborted
             # It is free to turn where it is: as early as the rest of the leg allows.
             way = s.on_way
             rest = (1 - way.share) * problem.travel(robot.name, way.origin, way.destination)
-            location, release = way.name, max(now, s.free_at - rest)
+            # Nor before its release: a robot standing at the start of its first leg may not
+            # have been released yet.
+            location, release = way.name, max(now, s.free_at - rest, robot.release_time)
             if way.share == 0:
                 location = way.origin
             else:
