@@ -41,7 +41,12 @@ def test_a_generated_scenario_runs_to_completion(fjsp_fleet, tmp_path, seed):
     fleet.check_mission_complete(timeout=90)
 
 
-@pytest.mark.parametrize('seed', fresh(3, salt=4))
+FAULT_SEEDS_FOUND = (105797401,)
+"""Seeds that once failed: a robot failed and recovered before its release time, and the
+re-plan let it leave at once (test_replan's robot not yet released)."""
+
+
+@pytest.mark.parametrize('seed', [*FAULT_SEEDS_FOUND, *fresh(3, salt=4)])
 def test_a_generated_scenario_survives_a_random_fault(fjsp_fleet, tmp_path, seed):
     """A robot drawn from the seed fails (and may recover), runs late or loses its agent at a
     moment drawn from the seed. A mission its robots can no longer finish is BLOCKED naming

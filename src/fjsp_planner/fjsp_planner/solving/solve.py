@@ -12,6 +12,7 @@ from fjsp_planner.solving.bounds.assignment import fleet_load_bound
 from fjsp_planner.solving.classic import solve_classic
 from fjsp_planner.solving.compact import left_shifted
 from fjsp_planner.solving.cpsat import solve_cpsat
+from fjsp_planner.solving.staffable import staffable
 from fjsp_planner.solving.start import find_start, greedy_result, run_from
 
 SOLVERS = ('cpsat', 'greedy', 'mip')
@@ -35,7 +36,9 @@ def solve(problem: Problem, solver: str = 'cpsat', time_limit: float = 10.0, wor
     panels (`portfolio`), beside the local search on other routed problems (`routed`), and
     randomised greedy passes where the CP-SAT routing model would be too large (`large`).
 
-    The whole call (greedy, model building, solving, keeping assignments) takes at most
+    Plans no robot of the problem can staff are left out first (`staffable`); the schedule
+    names plans as `problem` does. The whole call (greedy, model building, solving, keeping
+    assignments) takes at most
     `time_limit` seconds, plus the solver's reaction time to its own limit (milliseconds),
     for problems up to the size limit of the scenario checks (1000 jobs); but without a
     valid hint, a limit too short for any greedy pass is exceeded by one quick pass, so that
@@ -49,6 +52,11 @@ def solve(problem: Problem, solver: str = 'cpsat', time_limit: float = 10.0, wor
         raise ValueError(f'workers must be an integer from 1 to {MAX_WORKERS}, got {workers!r}')
     if not time_limit > 0:
         raise ValueError(f'time_limit must be a positive number of seconds, got {time_limit!r}')
+    lean = staffable(problem)
+    if lean is not None:
+        result = solve(lean.problem, solver, time_limit, workers, lean.staffable(hint),
+                       lean.staffable(keep), mip_backend, log)
+        return dataclasses.replace(result, schedule=lean.posed(result.schedule))
     began = time.monotonic()
     greedy_time = time_limit if solver == 'greedy' else GREEDY_SHARE * time_limit
     start = find_start(problem, hint, began, greedy_time, time_limit)
