@@ -528,6 +528,21 @@ def test_first_leg_leaves_from_the_start_location_once_released():
     assert kinds(r.step(0)) == [(ARRIVED, 'J1', 0), (STARTED, 'J1', 0)]
 
 
+def test_a_robot_failed_and_recovered_before_its_release_still_leaves_at_it():
+    """Found by a generated fleet (seed 105797401): released at 10 with a 10-unit first leg,
+    a robot failed at 4 and recovered at 5; following the re-plan, which again has it leave
+    at 10, it left at once and arrived before it could have."""
+    r = RobotExecution('C')
+    plan(r, 1, [task('J1', 20, 1, leg=10)])
+    assert r.step(4) == []
+    r.fail(4)
+    plan(r, 2, [], now=4.1)
+    r.recover(5)
+    plan(r, 3, [task('J1', 20, 1, leg=10)], now=5.1)
+    assert r.step(6) == [] and r.busy_until == pytest.approx(20)
+    assert kinds(r.step(22)) == [(ARRIVED, 'J1', 20), (STARTED, 'J1', 20), (DONE, 'J1', 21)]
+
+
 def test_a_later_mission_leaves_no_earlier_than_planned_although_placed():
     """Found by the soak: the truss's D2 (released at 3) ended a mission at bay3; in the next
     one, placed there, it left for the depot at once, arrived before its release time, and

@@ -126,7 +126,7 @@ class RobotExecution:
         self._not_before = 0.0
         """When the latest plan arrived: nothing it orders can begin earlier."""
         self._departed = False
-        """Whether it has left for its first job of the mission."""
+        """Whether it has set off for its first job of the mission (its departure came)."""
         self._phase_start = math.nan
         """When the leg or operation under way began, or the leg is to begin."""
         self._leg: Leg | None = None
@@ -553,6 +553,9 @@ class RobotExecution:
         if not self._begun:
             if now < self._phase_start:
                 return None
+            # Left only now: a robot failed before its departure (before its release, say)
+            # still leaves no earlier than the plan that brings it back has it leave.
+            self._departed = True
             if self._leg is None:
                 return self._phase_start
             self.driver.begin(self._leg, self._phase_start)
@@ -610,7 +613,6 @@ class RobotExecution:
                 leg = max(leg, share * stopped.duration)
         if not self._departed:
             departure = max(departure, task.travel_start)
-            self._departed = True
         self._phase = _Phase.TRAVEL
         self._phase_start = departure
         self._stopped = None
