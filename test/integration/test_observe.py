@@ -11,6 +11,7 @@ import subprocess
 import time
 import urllib.request
 
+import pytest
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from mcap.reader import make_reader
 
@@ -166,14 +167,29 @@ def test_diagnostics_show_failed_and_offline_robots(fjsp_fleet):
         return lambda o: any(s.name == f'monitor: robot {robot}' and s.hardware_id == robot
                              and s.level == level and words in s.message for s in statuses)
 
+    def heard_every_robot(o):
+        # A monitor that never heard a robot says STALE of it, whatever happens to it after.
+        return all(any(s.name == f'monitor: robot {robot}' and s.level != DiagnosticStatus.STALE
+                       for s in statuses) for robot in ROBOTS)
+
+    def last_said(robot) -> str:
+        with observer.lock:
+            said = [s for s in statuses if s.name == f'monitor: robot {robot}']
+        return f'{said[-1].level!r} {said[-1].message!r}' if said else 'nothing'
+
     fleet.wait_for(reported('Assembler', DiagnosticStatus.OK, ''), 30,
-                      'an OK diagnostic of the Assembler')
+                   'an OK diagnostic of the Assembler')
+    fleet.wait_for(heard_every_robot, 30, 'the monitor to hear every robot')
     fleet.inject_fault('MARC1', 'fail')
     fleet.wait_for(reported('MARC1', DiagnosticStatus.ERROR, 'failed'), 20,
-                      'an ERROR diagnostic of the failed MARC1')
+                   'an ERROR diagnostic of the failed MARC1')
     fleet.kill('agent_MARC2')
-    fleet.wait_for(reported('MARC2', DiagnosticStatus.ERROR, 'offline'), 20,
-                      'an ERROR diagnostic of MARC2, killed')
+    try:
+        fleet.wait_for(reported('MARC2', DiagnosticStatus.ERROR, 'offline'), 20,
+                       'an ERROR diagnostic of MARC2, killed')
+    except pytest.fail.Exception as failure:
+        pytest.fail(f'{failure}; the monitor last said of MARC2: {last_said("MARC2")}',
+                    pytrace=False)
     failed = next(s for s in statuses if s.name == 'monitor: robot MARC1'
                   and s.level == DiagnosticStatus.ERROR)
     assert {v.key: v.value for v in failed.values}['mode'] == 'failed'
@@ -231,7 +247,14 @@ def test_a_mission_on_a_map_is_recorded_for_foxglove_and_served(fjsp_fleet, tmp_
     fleet.start()
     wait_until_elapsed(fleet.observer, 5)
     mission_id = fleet.observer.plans[0].mission_id
-    page = urllib.request.urlopen(f'http://127.0.0.1:{port}/', timeout=10).read().decode()
+    # The monitor hears the fleet as the test does, not necessarily as soon.
+    deadline = time.monotonic() + 30
+    while True:
+        page = urllib.request.urlopen(f'http://127.0.0.1:{port}/', timeout=10).read().decode()
+        if f'<span id="mission-id">{mission_id}</span>' in page \
+                or time.monotonic() > deadline:
+            break
+        time.sleep(0.2)
     assert f'<span id="mission-id">{mission_id}</span>' in page
     assert '<span id="state" class="state" data-state="executing">executing</span>' in page
     assert all(f'<tr data-robot="{robot}">' in page for robot in robots)
