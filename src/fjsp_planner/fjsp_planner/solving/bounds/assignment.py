@@ -19,6 +19,7 @@ from ortools.sat.python import cp_model
 from fjsp_planner.model.problem import Problem
 from fjsp_planner.solving.bounds.geometry import least_leg_into
 from fjsp_planner.solving.bounds.jobs import fastest_sets
+from fjsp_planner.solving.cpsat.grid import objective_ticks
 
 MAX_GRID = 1000
 MAX_CHOICES = 20_000
@@ -102,5 +103,5 @@ def fleet_load_bound(problem: Problem, time_limit: float, workers: int = 1,
     if status in ('MODEL_INVALID', 'INFEASIBLE') or not math.isfinite(
             solver.best_objective_bound):
         return None
-    found = Fraction(math.ceil(solver.best_objective_bound), scale)
+    found = Fraction(objective_ticks(solver.best_objective_bound), scale)
     return found if incumbent is None else min(found, incumbent)

@@ -40,6 +40,7 @@ from fjsp_planner.solving.bounds.geometry import panel_distance, travel_factor
 from fjsp_planner.solving.bounds.jobs import fastest_sets, heads_and_tails
 from fjsp_planner.solving.bounds.machine import BOUND_SUBSOLVERS
 from fjsp_planner.solving.bounds.panel import panel_limits
+from fjsp_planner.solving.cpsat.grid import objective_ticks
 
 MAX_GRID = 1000
 MAX_CHOICES = 20_000
@@ -156,7 +157,7 @@ def _solve(problem: Problem, incumbent: Fraction, choices, time_limit: float, wo
         return incumbent
     if status == 'MODEL_INVALID' or not math.isfinite(solver.best_objective_bound):
         return None
-    return min(Fraction(math.ceil(solver.best_objective_bound), scale), incumbent)
+    return min(Fraction(objective_ticks(solver.best_objective_bound), scale), incumbent)
 
 
 def _cut_jobs(before, names):

@@ -39,6 +39,7 @@ from fjsp_planner.model.problem import Problem
 from fjsp_planner.solving.bounds.geometry import least_travel
 from fjsp_planner.solving.bounds.jobs import StaffingChoice, staffings, topological
 from fjsp_planner.solving.bounds.panel import panel_limits
+from fjsp_planner.solving.cpsat.grid import objective_ticks
 
 MAX_CHOICES = 8
 """Staffing choices kept apart per job and kind of choice; beyond, they merge into one at the
@@ -326,7 +327,7 @@ def _solve(jobs, lags, holds, kind_of, travel, time_limit, workers, subsolvers
             solver.best_objective_bound):
         return None
     # Proven whether or not a schedule of the relaxation was found in time.
-    return Fraction(math.ceil(solver.best_objective_bound), scale)
+    return Fraction(objective_ticks(solver.best_objective_bound), scale)
 
 
 def _resources(m, keys, holds, kind_of, start, end, length, uses, horizon):

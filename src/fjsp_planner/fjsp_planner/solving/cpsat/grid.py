@@ -20,6 +20,20 @@ from fjsp_planner.model.problem import Problem
 
 MAX_SCALE = 1000
 MAX_TICKS = 2**40
+OBJECTIVE_NOISE = 1e-9
+"""Relative rounding noise in the objective values and bounds CP-SAT reports as floats."""
+
+
+def objective_ticks(value: float) -> int:
+    """The integer an integer objective's value or bound, reported by CP-SAT as a float,
+    stands for (rounded up when it is not one). They come back with rounding noise
+    (6048.000000000001 for 6048): their ceiling would claim a bound one grid unit above
+    what is proven, above a reachable makespan, and make the search with that floor
+    infeasible."""
+    nearest = round(value)
+    if abs(value - nearest) <= OBJECTIVE_NOISE * max(1.0, abs(value)):
+        return nearest
+    return math.ceil(value)
 
 
 @dataclass(frozen=True)

@@ -1,6 +1,5 @@
 """Running CP-SAT on the model: parameters, time accounting, and the keep-assignments phase."""
 
-import math
 import threading
 import time
 from fractions import Fraction
@@ -10,6 +9,7 @@ from ortools.sat.python import cp_model
 from fjsp_planner.model.problem import Problem
 from fjsp_planner.model.schedule import Result, Schedule, Status
 from fjsp_planner.solving.cpsat import objective
+from fjsp_planner.solving.cpsat.grid import objective_ticks
 from fjsp_planner.solving.cpsat.model import CpsatModel
 from fjsp_planner.solving.cpsat.variables import OutOfTimeError
 
@@ -84,7 +84,7 @@ def solve_cpsat(problem: Problem, time_limit=10.0, workers=2, hint: Schedule | N
         return Result(Status.UNKNOWN, None, None, time.monotonic() - began, None, 'cpsat',
                       notes=model.notes)
     best = solver.value(model.makespan)
-    bound = Fraction(math.ceil(solver.best_objective_bound), model.grid.scale)
+    bound = Fraction(objective_ticks(solver.best_objective_bound), model.grid.scale)
     schedule = model.read(solver)
     if keep is not None and status == 'OPTIMAL':
         keep_time = min(time_limit * KEEP_SHARE, deadline - time.monotonic())
@@ -138,7 +138,7 @@ class _SolutionTimes(cp_model.CpSolverSolutionCallback):
             self.first = self.wall_time
         self.best = self.wall_time
         if self.handle is not None:
-            self.handle.best = Fraction(math.ceil(self.objective_value), self.scale)
+            self.handle.best = Fraction(objective_ticks(self.objective_value), self.scale)
             if self.reader is not None:
                 self.handle.schedule = self.reader(self)
 
