@@ -11,11 +11,12 @@ import pytest
 
 from fjsp_planner.model.problem import FixedJob, Job, Problem, Robot
 from fjsp_planner.model.scenario import load_scenario
-from fjsp_planner.model.schedule import Status
+from fjsp_planner.model.schedule import Result, Status
 from fjsp_planner.model.validate import validate
 from fjsp_planner.solving.bounds.jobs import critical_path_bound
 from fjsp_planner.solving.greedy import greedy_schedule
 from fjsp_planner.solving.solve import solve
+from fjsp_planner.solving.start import find_start, run_from
 
 from repo_paths import PAPER
 
@@ -222,3 +223,19 @@ def test_a_broken_hint_is_ignored_not_trusted():
     result = solve(problem, time_limit=10, hint=broken)
     assert result.makespan == 32 and validate(problem, result.schedule) == []
     assert any('hint is not a valid schedule' in note for note in result.notes)
+
+
+def test_a_search_wrongly_claiming_infeasibility_still_yields_the_valid_start():
+    """The start schedules are validated, so a search calling the problem infeasible was
+    misled (a bound too high): the caller gets the start's schedule and a note saying so."""
+    problem = load_scenario(PAPER)
+    began = time.monotonic()
+    start = find_start(problem, None, began, greedy_time=5, time_limit=5)
+
+    def misled(seconds):
+        return Result(Status.INFEASIBLE, None, None, 0.01, None, 'cpsat')
+
+    result = run_from(problem, start, began, 5, misled)
+    assert result.status == Status.FEASIBLE and result.schedule is start.greedy
+    assert validate(problem, result.schedule) == []
+    assert any('infeasible, which the starting schedule disproves' in n for n in result.notes)

@@ -44,8 +44,9 @@ def solve_routed(problem: Problem, start: Start, began: float, time_limit: float
     best, best_at = local_search(problem, first, deadline, stop=search.done)
     solver = 'local search' if best is not first else 'greedy'
     result = search.result()
-    if result.status == Status.INFEASIBLE:
-        raise RuntimeError('CP-SAT found a problem infeasible that has a valid schedule')
+    # The first schedule is valid: CP-SAT claiming infeasibility was given a bound too high.
+    disproved = (('CP-SAT claimed the problem infeasible, which the first schedule disproves',)
+             if result.status == Status.INFEASIBLE else ())
     if result.schedule is not None and result.makespan < best.makespan:
         best, solver = result.schedule, 'cpsat'
         best_at = search.started + (result.best_solution_seconds or result.solve_seconds)
@@ -55,4 +56,4 @@ def solve_routed(problem: Problem, start: Start, began: float, time_limit: float
                   best.makespan, bound, time.monotonic() - began, best, solver,
                   first_solution_seconds=setup, best_solution_seconds=max(best_at - began,
                                                                           setup),
-                  notes=start.notes + result.notes)
+                  notes=start.notes + result.notes + disproved)

@@ -87,19 +87,22 @@ def greedy_result(problem: Problem, start: Start, began: float) -> Result:
 def run_from(problem: Problem, start: Start, began: float, time_limit: float,
              search: Callable[[float], Result]) -> Result:
     """`search(seconds left)`, its times counted from `began`; the start's best schedule when
-    the search found none (unless it proved the problem infeasible)."""
+    the search found none. The start's schedule is valid, so a search claiming the problem
+    infeasible is wrong (a bound it was given is too high): the schedule is returned, and
+    the note says so."""
     setup = time.monotonic() - began
     result = search(max(0.05, time_limit - setup))
     best = start.best
-    if result.schedule is None and best is not None and result.status != Status.INFEASIBLE:
+    if result.schedule is None and best is not None:
         elapsed = time.monotonic() - began
         which = 'greedy schedule' if best is start.greedy else 'starting schedule'
+        found = ('claimed the problem infeasible, which the starting schedule disproves'
+                 if result.status == Status.INFEASIBLE else 'found no schedule')
         return Result(Status.FEASIBLE, best.makespan, static_bound(problem), elapsed,
                       best, 'greedy' if best is start.greedy else 'hint',
                       first_solution_seconds=setup, best_solution_seconds=setup,
                       notes=start.notes + result.notes + (
-                          f'{result.solver} found no schedule in {time_limit:g} s; {which} '
-                          'returned',))
+                          f'{result.solver} {found} in {time_limit:g} s; {which} returned',))
     return _count_from(problem, dataclasses.replace(result, notes=start.notes + result.notes),
                        setup)
 
