@@ -51,6 +51,7 @@ def test_a_solved_generated_scenario_and_its_re_plan_are_valid(seed):
     problem = parse_scenario(random_scenario(
         seed, Shape(jobs=rng.randint(4, 14), robots=rng.randint(3, 6))))
     result = solve(problem, time_limit=0.5, workers=1)
+    assert result.schedule is not None, (seed, result.status, result.notes)
     assert validate(problem, result.schedule) == [], seed
     schedule = result.schedule
     now = Fraction(rng.randint(0, int(schedule.makespan * 10)), 10)
