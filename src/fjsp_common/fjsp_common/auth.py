@@ -42,6 +42,10 @@ MAC_BYTES = 32
 HMAC_BUDGET = 100
 """Failed signature checks a second per name and claimed sender (see `Verifier`): a few tens
 of milliseconds of one core."""
+UNSIGNED_DECODED = 20
+"""Unsigned messages a second per name still decoded from their bytes (`Verifier.screen`), so
+that a sender without the key is named: an agent started without it is reported as unsigned,
+not as silent. More than a fleet of agents sends on a name in a second."""
 KEY_FILE_VARIABLE = 'FJSP_FLEET_KEY_FILE'
 """Where command-line tools and scripts find the fleet key when not told otherwise."""
 FLEET_KEY_FILE = ParameterSpec('fleet_key_file', '',
@@ -143,6 +147,17 @@ def client_signer(key_file, role: str) -> 'Signer':
                   f'{role}/{secrets.token_hex(CLIENT_ID_BYTES)}')
 
 
+def could_be_signed(data: bytes) -> bool:
+    """Whether a fleet message serialized as `data` (CDR after its 4-byte encapsulation header,
+    as a subscription takes it raw) ends with a MAC of MAC_BYTES. Every fleet message ends with
+    its `Auth`, and `Auth` with its MAC, a sequence: a 4-byte length, then the bytes. An
+    unsigned message ends with the length 0; only MAC_BYTES can verify."""
+    if len(data) < 4 + 4 + MAC_BYTES:
+        return False
+    order = 'little' if data[1] & 1 else 'big'
+    return int.from_bytes(data[-MAC_BYTES - 4:-MAC_BYTES], order) == MAC_BYTES
+
+
 class Signer:
     """Signs what one process sends as `sender`."""
 
@@ -174,7 +189,10 @@ class Verifier:
     stale messages costs no HMAC. A flood of forged signatures does: each name and claimed
     sender gets HMAC_BUDGET failed checks a second, after which messages claiming that sender
     are refused unchecked until the second is over. A forger can so silence the sender it
-    impersonates (its messages are refused with the forger's meanwhile), not the process."""
+    impersonates (its messages are refused with the forger's meanwhile), not the process.
+
+    Cheaper still, `screen` refuses from its bytes a message that cannot carry a signature,
+    before it is decoded into a message at all."""
 
     def __init__(self, key: bytes | None, clock=time.monotonic):
         self.key = key
@@ -183,6 +201,29 @@ class Verifier:
         self._clock = clock
         self._second = -1
         self._failed: Counter[tuple[str, str]] = Counter()
+        self._unsigned: Counter[str] = Counter()
+
+    def screen(self, data: bytes, name: str) -> bool:
+        """Whether a message received on resolved `name` as its serialized `data` is worth
+        decoding and `check`ing: it ends with a MAC of the right size, or it is one of the
+        first UNSIGNED_DECODED unsigned ones this second on `name` (its sender gets named).
+        The others are refused and counted here: decoding a message costs several times
+        what refusing its bytes does."""
+        if self.key is None or could_be_signed(data):
+            return True
+        self._start_second()
+        self._unsigned[name] += 1
+        if self._unsigned[name] <= UNSIGNED_DECODED:
+            return True
+        self.rejected += 1
+        return False
+
+    def _start_second(self) -> None:
+        second = int(self._clock())
+        if second != self._second:
+            self._second = second
+            self._failed.clear()
+            self._unsigned.clear()
 
     def check(self, msg, name: str, senders=None) -> str:
         """Why `msg`, received on resolved `name`, must be dropped ('' if it verifies).
@@ -207,10 +248,7 @@ class Verifier:
         latest = self._latest.get((name, sender))
         if latest is not None and stamp <= latest:
             return f"replayed message of '{sender[:80]}' (counter {auth.counter})"
-        second = int(self._clock())
-        if second != self._second:
-            self._second = second
-            self._failed.clear()
+        self._start_second()
         if self._failed[name, sender] >= HMAC_BUDGET:
             return (f"more than {HMAC_BUDGET} messages a second of '{sender[:80]}' do not "
                     'verify: refused unchecked')
@@ -267,6 +305,19 @@ class NodeAuth:
 
     def sign(self, msg, name: str, service: bool = False):
         return self.signer.sign(msg, self.resolve(name, service))
+
+    def screen(self, data: bytes, name: str) -> bool:
+        """Whether a message received on topic `name` as its serialized `data` is worth
+        decoding (`Verifier.screen`); if not, it is counted."""
+        return self.verifier.screen(data, self.resolve(name))
+
+    def unreadable(self, name: str) -> None:
+        """Count, and warn about once, a message on topic `name` that cannot be decoded."""
+        self.verifier.rejected += 1
+        if (name, '', 'unreadable') not in self._warned:
+            self._warned.add((name, '', 'unreadable'))
+            self.node.get_logger().warning(f'dropping a message on {name} that cannot be '
+                                           'decoded; further ones are only counted')
 
     def accept(self, msg, name: str, senders=None, service: bool = False) -> bool:
         """Whether `msg` received on `name` verifies; if not, it is counted and warned about
