@@ -8,7 +8,7 @@ import pytest
 from rclpy.serialization import deserialize_message, serialize_message
 
 from fjsp_common.auth import UNSIGNED_DECODED, Signer, Verifier, could_be_signed
-from fjsp_common.contract import TOPICS
+from fjsp_common.contract import ROBOT_STATES, TOPICS, subscription
 from fjsp_msgs.msg import RobotState
 
 KEY = bytes(range(32))
@@ -78,3 +78,63 @@ def test_without_a_key_everything_is_decoded():
     unsigned = serialize_message(state())
     assert all(verifier.screen(unsigned, NAME) for _ in range(1000))
     assert verifier.rejected == 0
+
+
+class FakeAuth:
+    enabled = True
+
+    def __init__(self):
+        self.verifier = Verifier(KEY, FakeClock())
+        self.unreadable_on: list[str] = []
+
+    def screen(self, data: bytes, name: str) -> bool:
+        return self.verifier.screen(data, name)
+
+    def unreadable(self, name: str) -> None:
+        self.unreadable_on.append(name)
+
+
+class FakeNode:
+    def create_subscription(self, msg_type, name, callback, qos, raw=False):
+        self.raw, self.callback = raw, callback
+        return FakeSubscription()
+
+
+class EmptyHandle:
+    """An rclpy subscription handle with nothing more waiting."""
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *_):
+        return False
+
+    def take_message(self, msg_type, raw):
+        return None
+
+
+class FakeSubscription:
+    handle = EmptyHandle()
+    msg_type = RobotState
+    raw = True
+
+
+def test_a_keyed_subscription_decodes_only_what_could_be_signed():
+    node, auth, heard = FakeNode(), FakeAuth(), []
+    subscription(node, ROBOT_STATES, heard.append, auth)
+    assert node.raw
+    unsigned = serialize_message(state())
+    for _ in range(UNSIGNED_DECODED + 5):
+        node.callback(unsigned)
+    node.callback(signed())
+    assert [len(msg.auth.mac) for msg in heard] == [0] * UNSIGNED_DECODED + [32]
+    assert auth.verifier.rejected == 5
+
+
+def test_bytes_that_end_like_a_signature_but_cannot_be_decoded_are_counted_not_raised():
+    node, auth, heard = FakeNode(), FakeAuth(), []
+    subscription(node, ROBOT_STATES, heard.append, auth)
+    garbage = b'\x00\x01\x00\x00' + b'\xff\xff\xff\x7f' + bytes(8) + (32).to_bytes(4, 'little') \
+        + bytes(32)
+    node.callback(garbage)
+    assert heard == [] and auth.unreadable_on == ['robot_states']

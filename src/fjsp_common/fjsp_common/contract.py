@@ -13,6 +13,7 @@ from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import PoseArray
 from rclpy.exceptions import InvalidHandle
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.serialization import deserialize_message
 from visualization_msgs.msg import MarkerArray
 
 from fjsp_common.diagnostics import DIAGNOSTICS_QOS, DIAGNOSTICS_TOPIC
@@ -116,7 +117,7 @@ DRAIN = 1000
 the node's other callbacks."""
 
 
-def subscription(node, topic: Topic, callback, **options):
+def subscription(node, topic: Topic, callback, auth=None, **options):
     """A subscription of `node` to `topic`, with the QoS its readers use, that takes every
     message waiting (up to DRAIN) each time the executor serves it.
 
@@ -125,7 +126,15 @@ def subscription(node, topic: Topic, callback, **options):
     (KEEP_LAST), so a flood beyond that rate — forged messages, dropped at once by the
     callback — would push the fleet's own messages out of the history before they are taken
     (robots' heartbeats lost: robots declared offline). Taken in a row, messages cost only
-    their callback."""
+    their callback.
+
+    With `auth` (the node's `NodeAuth`) in an authenticated fleet, signed topics are taken as
+    their bytes, and only what could carry a signature is decoded for `callback`
+    (`NodeAuth.screen`): decoding is most of what a flood of unsigned messages costs."""
+    if auth is not None and auth.enabled and not options.get('raw') \
+            and 'auth' in topic.type.get_fields_and_field_types():
+        callback = _screened(topic, callback, auth)
+        options['raw'] = True
     taking = []
 
     def take_all(msg) -> None:
@@ -135,6 +144,19 @@ def subscription(node, topic: Topic, callback, **options):
     sub = node.create_subscription(topic.type, topic.name, take_all, topic.qos, **options)
     taking.append(sub)
     return sub
+
+
+def _screened(topic: Topic, callback, auth):
+    def screen(data: bytes) -> None:
+        if not auth.screen(data, topic.name):
+            return
+        try:
+            msg = deserialize_message(data, topic.type)
+        except Exception:  # noqa: BLE001  bytes rclpy cannot read, whatever it raises
+            auth.unreadable(topic.name)
+            return
+        callback(msg)
+    return screen
 
 
 def take_waiting(sub, callback, limit: int = DRAIN) -> None:

@@ -150,8 +150,8 @@ class RobotAgent(Node):
 
         self.state_pub = publisher(self, ROBOT_STATES)
         self.event_pub = publisher(self, TASK_EVENTS)
-        subscription(self, PLAN, self.on_plan)
-        subscription(self, TASK_EVENTS, self.on_event)
+        subscription(self, PLAN, self.on_plan, self.auth)
+        subscription(self, TASK_EVENTS, self.on_event, self.auth)
         self.fault_service = f'{self.robot}/{INJECT_FAULT_SERVICE}'
         try:
             self.create_service(InjectFault, self.fault_service, self.on_fault,

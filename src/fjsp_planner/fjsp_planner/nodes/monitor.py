@@ -121,7 +121,7 @@ class MonitorNode(Node):
 
         self.auth = NodeAuth(self, MONITOR_NODE)
         for topic in (PLAN, ROBOT_STATES, TASK_EVENTS, MISSION_EVENTS, MISSION_STATUS):
-            subscription(self, topic, self.receiver(topic.type.__name__, topic.name))
+            subscription(self, topic, self.receiver(topic.type.__name__, topic.name), self.auth)
         self.diagnostics_pub = publisher(self, DIAGNOSTICS)
         self.poses_pub = publisher(self, ROBOT_POSES)
         self.map_pub = publisher(self, FLEET_MAP)

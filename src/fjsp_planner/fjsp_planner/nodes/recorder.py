@@ -118,6 +118,9 @@ class RecorderNode(Node):
         return record
 
     def verifies(self, topic, data: bytes) -> bool:
+        if not self.auth.screen(data, topic.name):
+            self.dropped[self.resolve_topic_name(topic.name)] += 1
+            return False
         try:
             msg = deserialize_message(data, topic.type)
         except Exception:  # noqa: BLE001  bytes rclpy cannot read, whatever it raises
