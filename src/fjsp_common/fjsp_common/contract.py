@@ -49,15 +49,21 @@ LATCHED_QOS = QoSProfile(
 )
 """The current plan and latest status: a node that joins late gets the last one."""
 
+ROBOT_STATE_HISTORY = 20_000
+"""Robot states a reader holds until it takes them: all writers of a topic share a reader's
+history, so it must hold what a flood of forged states delivers while the reader waits for a
+core (about a second of the fastest flood one process sends, docs/security.md), or the
+robots' own states are pushed out before they are taken. Small messages: a few megabytes."""
+
 ROBOT_STATES_QOS = QoSProfile(
     reliability=ReliabilityPolicy.RELIABLE,
     durability=DurabilityPolicy.TRANSIENT_LOCAL,
     history=HistoryPolicy.KEEP_LAST,
-    depth=MAX_FLEET,
+    depth=ROBOT_STATE_HISTORY,
 )
-"""Each agent is one writer keeping its latest state; a reader must hold one per robot, or a
-late joiner would get a single robot's state, and a burst (a failure followed at once by a
-recovery) could lose the failure before the reader's executor takes it."""
+"""Each agent is one writer keeping its latest state; a reader must hold at least one per
+robot, or a late joiner would get a single robot's state, and a burst (a failure followed at
+once by a recovery) could lose the failure before the reader's executor takes it."""
 
 EVENTS_QOS = QoSProfile(
     reliability=ReliabilityPolicy.RELIABLE,
