@@ -15,6 +15,9 @@ from repo_paths import PAPER
 ROBOTS = ('Assembler', 'LSMS', 'MARC1', 'MARC2')
 FLOOD_SECONDS = 20
 HEARTBEAT_TIMEOUT = 3.0
+"""The planner's. A loaded 2-core machine stalls the planner for over a second now and then,
+all robots' states late or lost at once: at the default (1 s) that alone declares robots
+offline, which is not what this test is about (docs/security.md, "Denial of service")."""
 FLOODER = """
 import math, sys, time
 import rclpy
