@@ -49,11 +49,12 @@ LATCHED_QOS = QoSProfile(
 )
 """The current plan and latest status: a node that joins late gets the last one."""
 
-ROBOT_STATE_HISTORY = 20_000
+ROBOT_STATE_HISTORY = 5000
 """Robot states a reader holds until it takes them: all writers of a topic share a reader's
 history, so it must hold what a flood of forged states delivers while the reader waits for a
-core (about a second of the fastest flood one process sends, docs/security.md), or the
-robots' own states are pushed out before they are taken. Small messages: a few megabytes."""
+core, or the robots' own states are pushed out before they are taken. As many as Fast DDS
+keeps for a reader (its default `max_samples`, which rclpy cannot raise): a deeper history
+holds no more."""
 
 ROBOT_STATES_QOS = QoSProfile(
     reliability=ReliabilityPolicy.RELIABLE,
