@@ -49,3 +49,21 @@ def test_a_job_starts_no_earlier_than_its_robots_can_arrive():
                         [Job('x', 'b', ((0,),)), Job('y', 'b', ((1,),))], [('x', 'y')])
     assert _Facts(problem).chain_bound() == 15
     assert solve(problem).makespan == 15
+
+
+def test_a_robot_may_reach_a_job_sooner_through_other_places():
+    """a to b is 20 direct, 10 through c (distances need not obey the triangle inequality):
+    W welds x at a (2), z at c from 7, y at b from 14: 16, the optimum. A head taking the
+    direct leg from a would hold y back to 20."""
+    distances = {}
+    for x, y, d in (('a', 'b', 20), ('a', 'c', 5), ('c', 'b', 5)):
+        distances[x, y] = distances[y, x] = Fraction(d)
+    problem = Problem(operation_types=OPS, robot_types={'Welder': {1: Fraction(2),
+                                                                   2: Fraction(1)}},
+                      robots=(Robot('W', 'Welder', start_location='a'),),
+                      jobs=(Job('x', 'a', ((1,),)), Job('y', 'b', ((1,),)),
+                            Job('z', 'c', ((1,),))),
+                      distances=distances, precedence=(('x', 'y'),), locomote=2)
+    assert solve(problem).makespan == 16
+    assert _Facts(problem).chain_bound() == 12
+    assert fleet_bound(problem) <= 16

@@ -1,7 +1,8 @@
 """Lower bounds for any scenario, from what the fleet must do (docs/solver.md, "Bounds").
 
 - Chains: a job starts no earlier than some robot able to do each of its operations can be
-  there (its release time, then the leg from its start location), and no earlier than its
+  there (its release time, then the least way from its start location along the distance
+  table, as it may work on its way), and no earlier than its
   predecessors (precedence and holding arcs) can end, each at its fastest; what must follow
   it takes at least its tail. The longest head + duration + tail bounds the makespan.
 - Energy over capability groups: for a set G of robots (those able to do one operation type,
@@ -26,7 +27,7 @@ schedule, so each holds for every schedule. Problems with running (fixed) jobs g
 from fractions import Fraction
 
 from fjsp_planner.model.problem import Problem, max_staffed
-from fjsp_planner.solving.bounds.geometry import least_leg_into
+from fjsp_planner.solving.bounds.geometry import least_leg_into, least_location_travel
 from fjsp_planner.solving.bounds.jobs import critical_path_bound, topological
 
 
@@ -69,11 +70,21 @@ class _Facts:
         self.readiness = {}
 
     def arrival(self, robot: str, location: str) -> Fraction:
-        """Earliest time the robot can be at `location`."""
+        """Earliest time the robot can be at `location` straight from its start location:
+        its first job's."""
         r = self.problem.robot(robot)
         if r.start_location is None:
             return r.release_time
         return r.release_time + self.problem.travel(robot, r.start_location, location)
+
+    def earliest_at(self, robot: str, location: str) -> Fraction:
+        """Earliest time the robot can be at `location`, working on its way or not
+        (distances need not obey the triangle inequality)."""
+        r = self.problem.robot(robot)
+        if r.start_location is None:
+            return r.release_time
+        return r.release_time + least_location_travel(self.problem, robot, r.start_location,
+                                                      location)
 
     def _heads_and_tails(self):
         p = self.problem
@@ -88,7 +99,7 @@ class _Facts:
         for name in order:
             job = p.job(name)
             # Each operation of the plan needs some able robot there.
-            there = min(max(min(self.arrival(r, job.location) for r in self.robots
+            there = min(max(min(self.earliest_at(r, job.location) for r in self.robots
                                 if q in self.able[r]) for q in plan) for plan in job.plans)
             heads[name] = max([there] + [heads[a] + self.fastest[a] for a in before[name]])
         tails = {}

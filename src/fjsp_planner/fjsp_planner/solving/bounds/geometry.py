@@ -76,10 +76,16 @@ def location_distance(problem: Problem, a: str, b: str) -> Fraction:
 def least_job_travel(problem: Problem, robot: str, first: str, second: str) -> Fraction:
     """Least time for the robot from job `first`'s place to job `second`'s, whatever it does
     in between."""
+    return least_location_travel(problem, robot, problem.job(first).location,
+                                 problem.job(second).location)
+
+
+def least_location_travel(problem: Problem, robot: str, a: str, b: str) -> Fraction:
+    """Least time for the robot from location `a` to location `b`, whatever it does in
+    between."""
     if problem.locomote is None:
         return Fraction(0)
-    return (location_distance(problem, problem.job(first).location,
-                              problem.job(second).location) * travel_factor(problem, robot))
+    return location_distance(problem, a, b) * travel_factor(problem, robot)
 
 
 def panel_distance(problem: Problem) -> Fraction:
