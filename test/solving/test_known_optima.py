@@ -12,6 +12,7 @@ from fjsp_planner.model.schedule import Status
 from fjsp_planner.model.validate import validate
 from fjsp_planner.solving.bounds import panel
 from fjsp_planner.solving.bounds.assignment import fleet_load_bound
+from fjsp_planner.solving.bounds.chains import chain_bound
 from fjsp_planner.solving.bounds.fleet import static_bound
 from fjsp_planner.solving.bounds.load import panel_load_bound
 from fjsp_planner.solving.bounds.machine import panel_machine_bound
@@ -46,13 +47,15 @@ def test_every_known_optimum_is_proven_again_by_each_of_its_provers(name):
 
 @pytest.mark.parametrize('name', list(KNOWN))
 def test_every_bound_stays_at_or_below_the_known_optimum(name):
-    """The static and fleet load bounds on every entry; on panels, the panel bounds too,
+    """The static, fleet load and chain bounds on every entry; on panels, the panel bounds too,
     given a schedule just above the optimum (as the search would report one)."""
     entry = KNOWN[name]
     problem = entry.problem()
     assert static_bound(problem) <= entry.optimum
     load = fleet_load_bound(problem, 10)
     assert load is None or load <= entry.optimum, 'fleet load'
+    chains = chain_bound(problem, 10)
+    assert chains is None or chains <= entry.optimum, 'chains'
     if not problem.panels:
         return
     incumbent = entry.optimum + 1

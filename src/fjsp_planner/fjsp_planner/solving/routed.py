@@ -3,17 +3,19 @@ search side by side, from the start (docs/solver.md, "Local search").
 
 CP-SAT runs in a thread of its own from the start's schedule, for its bound and its own
 improvements; the local search (`local`) runs meanwhile from the same schedule, and the
-fleet load bound (`bounds.assignment`) in a thread of its own for a short share of the
-limit. The shorter schedule wins; the bound is the best of CP-SAT's, the static bound and
-the fleet load bound.
+fleet load and chain bounds (`bounds.assignment`, `bounds.chains`) one after the other in a
+thread of their own, each for a short share of the limit. The shorter schedule wins; the
+bound is the best of CP-SAT's, the static bound and those two.
 """
 
 import time
+from fractions import Fraction
 
 from fjsp_planner.model.problem import Problem
 from fjsp_planner.model.schedule import Result, Status
 from fjsp_planner.solving.beside import Beside, CpsatBeside
 from fjsp_planner.solving.bounds.assignment import fleet_load_bound
+from fjsp_planner.solving.bounds.chains import chain_bound
 from fjsp_planner.solving.bounds.fleet import static_bound
 from fjsp_planner.solving.local import local_search
 from fjsp_planner.solving.start import Start
@@ -23,6 +25,8 @@ MIN_JOBS = 25
 LOAD_BOUND_SHARE = 0.05
 """Share of the time limit for the fleet load bound, on one core beside the search: it
 comes within 1 % of its optimum in about a second on 120 jobs."""
+CHAIN_BOUND_SHARE = 0.1
+"""Share of the time limit for the chain bound, after the fleet load bound."""
 
 
 def applies(problem: Problem, start: Start, keep) -> bool:
@@ -33,14 +37,25 @@ def applies(problem: Problem, start: Start, keep) -> bool:
             and len(problem.jobs) > MIN_JOBS)
 
 
+def search_free_bound(problem: Problem, time_limit: float,
+                      incumbent: Fraction | None = None) -> Fraction | None:
+    """The better of the fleet load bound and the chain bound, one after the other on one
+    core, each in its share of `time_limit`; None when neither applies."""
+    found = [bound for bound in (
+        fleet_load_bound(problem, LOAD_BOUND_SHARE * time_limit, incumbent=incumbent),
+        chain_bound(problem, CHAIN_BOUND_SHARE * time_limit, incumbent=incumbent))
+        if bound is not None]
+    return max(found, default=None)
+
+
 def solve_routed(problem: Problem, start: Start, began: float, time_limit: float,
                  workers: int, log: bool) -> Result:
     deadline = began + time_limit
     first = start.best
     setup = time.monotonic() - began
     search = CpsatBeside(problem, deadline, workers, first, start.hint or first, log)
-    load = Beside('fleet load bound', lambda: fleet_load_bound(
-        problem, LOAD_BOUND_SHARE * time_limit, incumbent=first.makespan))
+    load = Beside('fleet load and chain bounds', lambda: search_free_bound(
+        problem, time_limit, first.makespan))
     best, best_at = local_search(problem, first, deadline, stop=search.done)
     solver = 'local search' if best is not first else 'greedy'
     result = search.result()

@@ -8,7 +8,6 @@ from fjsp_planner.model.limits import MAX_WORKERS
 from fjsp_planner.model.problem import Problem
 from fjsp_planner.model.schedule import Result, Schedule
 from fjsp_planner.solving import large, portfolio, routed, tabu
-from fjsp_planner.solving.bounds.assignment import fleet_load_bound
 from fjsp_planner.solving.classic import solve_classic
 from fjsp_planner.solving.compact import left_shifted
 from fjsp_planner.solving.cpsat import solve_cpsat
@@ -89,8 +88,7 @@ def _backend(problem, solver, start, began, time_limit, workers, keep, mip_backe
         return routed.solve_routed(problem, start, began, time_limit, workers, log)
     # A proven bound lets CP-SAT stop as soon as a schedule meets it; a re-plan (keep) goes
     # without, as the time it takes counts against the re-plan's latency.
-    bound = None if keep is not None else fleet_load_bound(
-        problem, routed.LOAD_BOUND_SHARE * time_limit)
+    bound = None if keep is not None else routed.search_free_bound(problem, time_limit)
     return run_from(problem, start, began, time_limit, lambda left: solve_cpsat(
         problem, left, workers, hint=start.hint, keep=keep, upper_bound=start.best, log=log,
         lower_bound=bound))

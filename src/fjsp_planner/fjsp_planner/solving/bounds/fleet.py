@@ -49,6 +49,13 @@ def fleet_bound(problem: Problem) -> Fraction:
     return max(facts.chain_bound(), facts.energy_bound(), facts.robot_bound())
 
 
+def heads_tails_and_fastest(problem: Problem):
+    """job -> its head (the chains of the module docstring), job -> its tail, job -> its
+    least duration: what holds for every schedule of a problem without running jobs."""
+    facts = _Facts(problem)
+    return facts.heads, facts.tails, facts.fastest
+
+
 class _Facts:
     def __init__(self, problem: Problem):
         self.problem = p = problem

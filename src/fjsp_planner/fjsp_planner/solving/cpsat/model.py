@@ -21,9 +21,12 @@ from fjsp_planner.solving.cpsat.variables import JobVariables, RouteVariables, c
 
 
 class CpsatModel:
-    def __init__(self, problem: Problem, upper_bound: Schedule | None, deadline=None):
+    def __init__(self, problem: Problem, upper_bound: Schedule | None, deadline=None,
+                 delay: Fraction = Fraction(0)):
         """`upper_bound` is a valid schedule: its makespan bounds the horizon and the panel
-        cuts. Building past `deadline` (time.monotonic()) raises `OutOfTimeError`."""
+        cuts. Without one, the horizon is that of doing the jobs one after another, `delay`
+        later (for a caller that holds jobs back until then). Building past `deadline`
+        (time.monotonic()) raises `OutOfTimeError`."""
         from fjsp_planner.solving.greedy import serial_upper_bound
 
         clock = time.monotonic
@@ -36,7 +39,7 @@ class CpsatModel:
                 check(deadline, clock)
                 self.legs.update({(r.name, a, b): p.travel(r.name, a, b) for b in locations})
         incumbent = upper_bound.makespan if upper_bound is not None else None
-        bound = incumbent if incumbent is not None else serial_upper_bound(p)
+        bound = incumbent if incumbent is not None else serial_upper_bound(p) + delay
         self.grid = grid = choose_grid(p, list(self.legs.values()), bound)
         self.notes = (grid.note,)
         slack = 0 if grid.exact or incumbent is None else 2 * len(p.jobs) + 2
