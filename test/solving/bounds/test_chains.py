@@ -5,6 +5,7 @@ import dataclasses
 from fractions import Fraction
 
 from fjsp_planner.model.problem import FixedJob, Job, Problem, Robot
+from fjsp_planner.solving.bounds import chains
 from fjsp_planner.solving.bounds.assignment import fleet_load_bound
 from fjsp_planner.solving.bounds.chains import chain_bound
 from fjsp_planner.solving.bounds.fleet import static_bound
@@ -42,15 +43,29 @@ def test_a_chain_is_slow_unless_its_fast_robot_travels():
     assert static_bound(problem) < 7
 
 
-def test_a_robot_between_two_chain_jobs_goes_the_least_way_along_the_table():
+def test_a_robot_between_two_chain_jobs_goes_the_least_way_along_the_table(monkeypatch):
     """a to b is 20 direct, 10 through c, where z (outside the chain) waits: F welds x, z
-    on its way and y by 13. Taking the direct leg, the chain x -> y would be 1 + 20 + 1; the
-    least way gives 12, below the optimum."""
+    on its way and y by 13. Taking the direct leg, the chain x -> y alone would be
+    1 + 20 + 1; the least way gives 12, below the optimum."""
+    monkeypatch.setattr(chains, 'PAIRED_CHAINS', 0)
     problem = sites([Robot('F', 'Fast', start_location='a')],
                     [('x', 'a'), ('y', 'b'), ('z', 'c')], [('x', 'y')],
                     [('a', 'b', 20), ('a', 'c', 5), ('c', 'b', 5)])
     assert solve(problem).makespan == 13
     assert chain_bound(problem, 5) == 12
+
+
+def test_two_chains_together_share_their_fast_robot(monkeypatch):
+    """Two chains x1 -> y1 and x2 -> y2 from a to b: each alone takes 7 (F crosses), but F
+    cannot cross for both at once: F welds x1, x2, crosses and welds y2 by 8 while S welds
+    y1 from 1 to 15/2; the optimum is 8, which the two chains taken together prove."""
+    problem = sites([Robot('F', 'Fast', start_location='a'),
+                     Robot('S', 'Slow', start_location='b')],
+                    [('x1', 'a'), ('y1', 'b'), ('x2', 'a'), ('y2', 'b')],
+                    [('x1', 'y1'), ('x2', 'y2')], [('a', 'b', 5)])
+    assert chain_bound(problem, 5) == 8 == solve(problem).makespan
+    monkeypatch.setattr(chains, 'PAIRED_CHAINS', 0)
+    assert chain_bound(problem, 5) == 7
 
 
 def test_running_jobs_or_no_precedence_get_none():

@@ -12,6 +12,7 @@ the robots and their ways are chosen together, by CP-SAT on the full model of th
 """
 
 import dataclasses
+import itertools
 import math
 import time
 from fractions import Fraction
@@ -26,6 +27,9 @@ from fjsp_planner.solving.cpsat.variables import OutOfTimeError
 
 MOST_CHAINS = 24
 """Chains tried at most, longest first (at their fastest, with heads and tails)."""
+PAIRED_CHAINS = 5
+"""After the chains alone, every two of this many longest are tried together: their robots
+and ways are coupled."""
 CHAIN_SHARE = 0.34
 """Most of the time limit one chain may take: a chain CP-SAT cannot prove quickly gives
 what it proved and the time goes to the next."""
@@ -45,7 +49,10 @@ def chain_bound(problem: Problem, time_limit: float, incumbent: Fraction | None 
     least = {(a, b): location_distance(problem, a, b) for a in places for b in places
              if a != b}
     best = None
-    for chain in longest_chains(problem, heads, tails, fastest)[:MOST_CHAINS]:
+    chains = longest_chains(problem, heads, tails, fastest)
+    paired = [tuple(dict.fromkeys(a + b)) for a, b in itertools.combinations(
+        chains[:PAIRED_CHAINS], 2)]
+    for chain in chains[:MOST_CHAINS] + paired:
         left = deadline - time.monotonic()
         if left <= 0:
             break
