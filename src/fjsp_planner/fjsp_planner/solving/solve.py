@@ -6,13 +6,15 @@ import time
 
 from fjsp_planner.model.limits import MAX_WORKERS
 from fjsp_planner.model.problem import Problem
-from fjsp_planner.model.schedule import Result, Schedule
+from fjsp_planner.model.schedule import Result, Schedule, Status
 from fjsp_planner.solving import large, portfolio, routed, tabu
+from fjsp_planner.solving.bounds.assignment import fleet_load_bound
+from fjsp_planner.solving.bounds.chains import chain_bound
 from fjsp_planner.solving.classic import solve_classic
 from fjsp_planner.solving.compact import left_shifted
 from fjsp_planner.solving.cpsat import solve_cpsat
 from fjsp_planner.solving.staffable import staffable
-from fjsp_planner.solving.start import find_start, greedy_result, run_from
+from fjsp_planner.solving.start import find_start, greedy_result, raised_bound, run_from
 
 SOLVERS = ('cpsat', 'greedy', 'mip')
 GREEDY_SHARE = 0.4
@@ -86,12 +88,27 @@ def _backend(problem, solver, start, began, time_limit, workers, keep, mip_backe
         return portfolio.solve_panels(problem, start, began, time_limit, workers, keep, log)
     if routed.applies(problem, start, keep):
         return routed.solve_routed(problem, start, began, time_limit, workers, log)
-    # A proven bound lets CP-SAT stop as soon as a schedule meets it; a re-plan (keep) goes
-    # without, as the time it takes counts against the re-plan's latency.
-    bound = None if keep is not None else routed.search_free_bound(problem, time_limit)
-    return run_from(problem, start, began, time_limit, lambda left: solve_cpsat(
-        problem, left, workers, hint=start.hint, keep=keep, upper_bound=start.best, log=log,
-        lower_bound=bound))
+    if keep is not None:
+        # A re-plan's bound would cost time that counts against its latency.
+        return run_from(problem, start, began, time_limit, lambda left: solve_cpsat(
+            problem, left, workers, hint=start.hint, keep=keep, upper_bound=start.best,
+            log=log))
+    # A proven bound lets CP-SAT stop as soon as a schedule meets it. The chain bound gets
+    # the end of the limit, and only when CP-SAT has not proven its schedule optimal by then:
+    # small scenarios are often proven in less.
+    bound = fleet_load_bound(problem, routed.LOAD_BOUND_SHARE * time_limit)
+    result = run_from(
+        problem, start, began, (1 - routed.CHAIN_BOUND_SHARE) * time_limit,
+        lambda left: solve_cpsat(problem, left, workers, hint=start.hint, upper_bound=start.best,
+                                 log=log, lower_bound=bound))
+    if result.status == Status.OPTIMAL or result.schedule is None:
+        return result
+    chains = chain_bound(problem, began + time_limit - time.monotonic(), result.makespan)
+    if chains is None:
+        return result
+    return dataclasses.replace(
+        raised_bound(result, chains, 'bound raised to {} by the chain bound'),
+        solve_seconds=time.monotonic() - began)
 
 
 def _left_shifted(problem: Problem, result: Result) -> Result:
