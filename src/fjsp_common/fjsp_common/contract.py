@@ -180,6 +180,14 @@ def take_waiting(sub, callback, limit: int = DRAIN) -> None:
         callback(taken[0])
 
 
+def catch_up(sub) -> None:
+    """Serve `sub` now with the messages waiting in its history, as the executor would: a
+    node about to judge by what it heard (a robot silent for too long) first takes what has
+    arrived. The executor serves a node's timers before its subscriptions, so a node kept
+    from a core for a while would otherwise judge by what it heard before."""
+    take_waiting(sub, sub.callback, limit=1)  # its callback takes the rest
+
+
 def _pair(vocabulary, message, prefix: str) -> tuple[dict, dict]:
     to_msg = {word: getattr(message, f'{prefix}_{word.name}') for word in vocabulary}
     constants = {getattr(message, name) for name in dir(message) if name.startswith(f'{prefix}_')}

@@ -52,6 +52,7 @@ from fjsp_common.contract import (
     STATE_TO_MSG,
     TASK_EVENTS,
     TASK_EVENTS_TOPIC,
+    catch_up,
     publisher,
     subscription,
 )
@@ -250,8 +251,8 @@ class PlannerNode(Node):
         resumed once it takes charge must know what the robots did meanwhile."""
         self.arrivals = itertools.count()
         self.make_publishers()
-        subscription(self, ROBOT_STATES, self.on_robot_state, self.auth)
-        subscription(self, TASK_EVENTS, self.on_event, self.auth)
+        self.robot_states = subscription(self, ROBOT_STATES, self.on_robot_state, self.auth)
+        self.task_events = subscription(self, TASK_EVENTS, self.on_event, self.auth)
         subscription(self, PLAN, self.on_plan, self.auth)
         subscription(self, MISSION_STATUS, self.on_status, self.auth)
         self.create_timer(0.1, self.tick)
@@ -748,7 +749,10 @@ class PlannerNode(Node):
             except JournalError as error:
                 self.set_aside(error)
                 return
-        self.carry_out(self.controller.tick(wall, self.plan_pub.get_subscription_count()))
+        # Robots are judged silent by what has arrived, not by what the executor served.
+        catch_up(self.task_events)
+        catch_up(self.robot_states)
+        self.carry_out(self.controller.tick(self.wall(), self.plan_pub.get_subscription_count()))
 
     def on_robot_state(self, msg: RobotState) -> None:
         why = self.auth.refusal(msg, ROBOT_STATES_TOPIC, {msg.robot})
