@@ -113,14 +113,18 @@ class Fleet:
             if not isinstance(effect, Solve) or (effect.kind == SolveKind.IMPROVE
                                                  and not improve_too):
                 continue
-            if effect.kind == SolveKind.PLAN:
-                outcome = solve(effect.problem, time_limit=effect.time_limit)
-            elif effect.kind == SolveKind.REPAIR:
-                outcome = repair(effect.problem, effect.previous, effect.state,
-                                 time_limit=effect.time_limit)
-            else:
-                outcome = improve(effect.published, time_limit=effect.time_limit,
-                                  frozen_until=effect.frozen_until, started=effect.started)
+            try:
+                if effect.kind == SolveKind.PLAN:
+                    outcome = solve(effect.problem, time_limit=effect.time_limit)
+                elif effect.kind == SolveKind.REPAIR:
+                    outcome = repair(effect.problem, effect.previous, effect.state,
+                                     time_limit=effect.time_limit)
+                else:
+                    outcome = improve(effect.published, time_limit=effect.time_limit,
+                                      frozen_until=effect.frozen_until,
+                                      started=effect.started)
+            except ValueError as error:  # the node hands the controller what a solve raised
+                outcome = error
             out += self.take(self.controller.solved(effect.token, outcome, self.wall))
         return out
 
@@ -1139,6 +1143,51 @@ def test_a_resumed_mission_whose_histories_break_the_timeline_fails(problem):
     history_of(restarted, plan, time=0.0)
     assert restarted.state() == MissionState.FAILED
     assert any('executed timeline' in r for r in restarted.status().blocked)
+
+
+def test_a_silent_robots_late_completion_does_not_block_the_robots_that_moved_on(problem):
+    """A robot whose reports stop reaching the planner (its writer flooded) finishes its
+    operation on Aa; Aa's other robots, which heard it, move on to their next job. Their
+    arrival there tells the planner Aa is complete (a robot leaves a job only once every
+    robot on it is done), so the re-plan without the silent robot starts from a consistent
+    state instead of having the movers on two jobs at once; its late report changes
+    nothing, and every job is done exactly once."""
+    fleet = executing(problem)
+    plan = fleet.controller.mission.schedule
+    aa = plan.jobs['Aa']
+    silent = next(r for r in aa.robots if r not in plan.jobs['Ja'].robots)
+    movers = [r for r in aa.robots if r != silent]
+    following = {r: plan.sequences[r][plan.sequences[r].index('Aa') + 1] for r in movers}
+    assert set(following.values()) == {'Jb'}  # the paper's optimum: the holders go on to Jb
+    jb = plan.jobs['Jb']
+    fleet.tick(advance=float(jb.start) + 0.5)
+    fleet.execute(until=aa.start)
+    for robot in aa.robots:
+        fleet.event(EventKind.STARTED, robot, 'Aa', float(aa.start))
+    for robot in movers:
+        fleet.event(EventKind.OPERATION_DONE, robot, 'Aa',
+                    float(aa.start + problem.duration(robot, aa.robots[robot])))
+    silent_end = float(aa.start + problem.duration(silent, aa.robots[silent]))
+    for robot in movers:
+        for kind in (EventKind.ARRIVED, EventKind.STARTED):
+            fleet.event(kind, robot, 'Jb', float(jb.start))
+    # The silent robot is declared offline: the re-plan goes on without it.
+    others = tuple(r for r in ROBOTS if r != silent)
+    fleet.tick(advance=1.5, robots=others)
+    fleet.run_solves()
+    assert fleet.state() == MissionState.EXECUTING, fleet.status().blocked
+    assert [e.job for e in kinds(fleet.effects, JobDone)].count('Aa') == 1
+    assert fleet.controller.mission.tracker.revision == 2
+    # It is back, and its report of Aa arrives at last.
+    fleet.tick(advance=1.5)
+    fleet.event(EventKind.OPERATION_DONE, silent, 'Aa', silent_end, revision=1)
+    fleet.run_solves()
+    assert fleet.state() == MissionState.EXECUTING, fleet.status().blocked
+    fleet.execute()
+    assert fleet.state() == MissionState.COMPLETE, fleet.status().blocked
+    done = [e.job for e in kinds(fleet.effects, JobDone)]
+    assert sorted(done) == sorted(j.name for j in problem.jobs)
+    assert fleet.controller.mission.tracker.violations() == []
 
 
 def test_an_execution_state_the_tracker_cannot_tell_blocks_the_mission(problem):

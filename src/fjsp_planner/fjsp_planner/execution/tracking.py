@@ -198,12 +198,51 @@ class MissionTracker:
         if kind == EventKind.OPERATION_DONE:
             robots = self.plan.jobs[job].robots
             if all(r in record.operation_done for r in robots):
-                record.end = max(record.operation_done[r] for r in robots)
-                planned = self.plan.jobs[job]
-                record.done_as = JobAssignment(job, planned.plan, Fraction(record.start),
-                                               Fraction(record.end), dict(robots))
+                self._complete(job, max(record.operation_done[r] for r in robots))
                 return Verdict(job_done=(job, record.end))
+            return Verdict()
+        left = self._left_behind(robot, job)
+        if left is not None:
+            return Verdict(job_done=left)
         return Verdict()
+
+    def _complete(self, job: str, end: float) -> None:
+        record, planned = self.jobs[job], self.plan.jobs[job]
+        record.end = end
+        record.done_as = JobAssignment(job, planned.plan, Fraction(record.start),
+                                       Fraction(end), dict(planned.robots))
+
+    def _left_behind(self, robot: str, job: str) -> tuple[str, float] | None:
+        """The job `robot` was on before `job` in its sequence, if it still runs here: it is
+        complete, and its end is returned.
+
+        An agent leaves a job only once every robot on it reported its operation done (or
+        the planner declared it done), and goes on to the next job of its sequence. So its
+        arrival at that next job proves the job before complete, even when the report of
+        one of its robots has not reached the planner: that robot's writer may be flooded
+        or cut off, its robot declared offline, and the report arrive much later or never.
+        Waiting for it would leave the robots that moved on counted on two jobs at once,
+        a state no re-plan can start from. The job ended when the robot left it: at the
+        latest its arrival less the leg, and not before any of its robots reported done.
+        """
+        sequence = self.plan.sequences.get(robot, ())
+        if job not in sequence:
+            return None
+        position = sequence.index(job)
+        if position == 0:
+            return None
+        before = sequence[position - 1]
+        record = self.jobs[before]
+        if record.end is not None or not record.started or record.aborted \
+                or robot not in record.operation_done:
+            return None
+        here = self.jobs[job]
+        arrival = here.arrived.get(robot, here.started.get(robot))
+        leg = self.problem.travel(robot, self.problem.job(before).location,
+                                  self.problem.job(job).location)
+        end = max(arrival - float(leg), *record.operation_done.values())
+        self._complete(before, end)
+        return before, end
 
     def _check_event(self, event_id, kind, robot, job, revision, time) -> Verdict | None:
         if not isinstance(event_id, str):
