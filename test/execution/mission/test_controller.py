@@ -1190,6 +1190,35 @@ def test_a_silent_robots_late_completion_does_not_block_the_robots_that_moved_on
     assert fleet.controller.mission.tracker.violations() == []
 
 
+def test_contradicting_reports_block_the_mission_until_the_missing_ones_arrive(problem):
+    """Assembler's start of Aa arrives before its own end of Ja (a history resent out of
+    order): it looks on two jobs at once. The mission is blocked saying so, and re-planned
+    once the missing reports make the state consistent, without any robot changing."""
+    fleet = executing(problem)
+    plan = fleet.controller.mission.schedule
+    ja, aa = plan.jobs['Ja'], plan.jobs['Aa']
+    fleet.tick(advance=float(aa.start) + 0.5)
+    fleet.execute(until=ja.start)
+    for robot in ja.robots:
+        fleet.event(EventKind.STARTED, robot, 'Ja', float(ja.start))
+    fleet.event(EventKind.STARTED, 'Assembler', 'Aa', float(aa.start))
+    fleet.failures['LSMS'] += 1
+    fleet.report('LSMS', RobotMode.FAILED)
+    fleet.tick()
+    fleet.run_solves()
+    assert fleet.state() == MissionState.BLOCKED
+    (reason,) = fleet.status().blocked
+    assert reason.startswith("the robots' reports so far contradict each other")
+    assert "robot 'Assembler' runs both" in reason
+    for robot, operation in ja.robots.items():
+        fleet.event(EventKind.OPERATION_DONE, robot, 'Ja',
+                    float(ja.start + problem.duration(robot, operation)))
+    fleet.tick()
+    fleet.run_solves()
+    assert fleet.state() == MissionState.EXECUTING, fleet.status().blocked
+    assert fleet.controller.mission.tracker.revision == 2
+
+
 def test_an_execution_state_the_tracker_cannot_tell_blocks_the_mission(problem):
     fleet = executing(problem)
     tracker = fleet.controller.mission.tracker
