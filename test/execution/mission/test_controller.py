@@ -1190,6 +1190,49 @@ def test_a_silent_robots_late_completion_does_not_block_the_robots_that_moved_on
     assert fleet.controller.mission.tracker.violations() == []
 
 
+@pytest.mark.parametrize('late', ['none', 'before back', 'after back', 'after replan'])
+def test_a_robot_offline_mid_job_that_kept_working_does_not_block_the_mission(problem, late):
+    """Assembler goes silent on Ja while in fact it works on; the planner re-plans without
+    it, which redoes Ja. Its reports of the old attempt (Ja finished, Aa begun) arrive at
+    any point: while it is offline, once it is back, or after the re-plan that takes it
+    back. They no longer count, and the mission completes with every job done once."""
+    fleet = executing(problem)
+    plan = fleet.controller.mission.schedule
+    ja, aa = plan.jobs['Ja'], plan.jobs['Aa']
+    assert 'Assembler' in ja.robots and 'Assembler' in aa.robots
+    fleet.tick(advance=float(ja.start) + 0.5)
+    fleet.execute(until=ja.start)
+    for robot in ja.robots:
+        fleet.event(EventKind.STARTED, robot, 'Ja', float(ja.start))
+    old = [(EventKind.OPERATION_DONE, 'Ja',
+            float(ja.start + problem.duration('Assembler', ja.robots['Assembler']))),
+           (EventKind.ARRIVED, 'Aa', float(aa.start)), (EventKind.STARTED, 'Aa', float(aa.start))]
+
+    def old_reports():
+        for kind, job, time in old:
+            fleet.event(kind, 'Assembler', job, time, revision=1)
+
+    others = ROBOTS[1:]
+    fleet.tick(advance=1.5, robots=others)
+    fleet.run_solves()
+    assert fleet.controller.mission.tracker.revision == 2
+    if late == 'before back':
+        old_reports()
+    fleet.tick(advance=0.5)
+    if late == 'after back':
+        old_reports()
+    fleet.tick(advance=1.0)
+    fleet.run_solves()
+    if late == 'after replan':
+        old_reports()
+    assert fleet.controller.mission.tracker.revision == 3
+    assert fleet.state() == MissionState.EXECUTING, fleet.status().blocked
+    fleet.execute()
+    assert fleet.state() == MissionState.COMPLETE, fleet.status().blocked
+    done = [e.job for e in kinds(fleet.effects, JobDone)]
+    assert sorted(done) == sorted(j.name for j in problem.jobs)
+
+
 def test_contradicting_reports_block_the_mission_until_the_missing_ones_arrive(problem):
     """Assembler's start of Aa arrives before its own end of Ja (a history resent out of
     order): it looks on two jobs at once. The mission is blocked saying so, and re-planned
