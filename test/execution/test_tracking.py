@@ -799,3 +799,49 @@ def test_the_projection_never_reads_below_the_optimum_of_an_executed_mission(
                                                                        abs=1e-9), now
         assert replanned.makespan >= least
     assert tracker.complete
+
+
+def reach_aa_with_one_report_missing(planned, mover_done=True):
+    """Aa under way, every operation on it done but the welder's, whose report is missing;
+    its holders may go on to Jb. The tracker, the plan, Aa and the holders."""
+    problem, schedule = planned
+    tracker = MissionTracker(problem)
+    tracker.set_plan(schedule, 1)
+    aa = schedule.jobs['Aa']
+    run_plan(tracker, schedule, until=aa.start)
+    holders = [r for r in aa.robots if r in schedule.jobs['Ja'].robots]
+    for robot in aa.robots:
+        tracker.record_event(f'{robot}/Aa/started', EventKind.STARTED, robot, 'Aa', 1,
+                             float(aa.start))
+    for robot in holders if mover_done else holders[1:]:
+        tracker.record_event(f'{robot}/Aa/done', EventKind.OPERATION_DONE, robot, 'Aa', 1,
+                             float(aa.start + problem.duration(robot, aa.robots[robot])))
+    return tracker, schedule, aa, holders
+
+
+def test_a_robots_arrival_at_its_next_job_completes_the_job_it_left(planned):
+    """A robot leaves a job only once every robot on it is done: its arrival at its next job
+    completes the job, at the arrival less the leg, though a report of it is missing."""
+    tracker, schedule, aa, holders = reach_aa_with_one_report_missing(planned)
+    mover = holders[0]
+    assert schedule.sequences[mover][schedule.sequences[mover].index('Aa') + 1] == 'Jb'
+    leg = tracker.problem.travel(mover, 'Aa', 'Jb')
+    verdict = tracker.record_event('mover/Jb/arrived', EventKind.ARRIVED, mover, 'Jb', 1,
+                                   float(aa.end + leg))
+    assert verdict.job_done == ('Aa', float(aa.end))
+    assert 'Aa' in tracker.done and 'Aa' not in tracker.running
+    assert tracker.jobs['Aa'].done_as == aa
+    (welder,) = set(aa.robots) - set(holders)
+    late = tracker.record_event('welder/Aa/done', EventKind.OPERATION_DONE, welder, 'Aa', 1,
+                                float(aa.end))
+    assert late.ignored == Ignored.DUPLICATE and tracker.jobs['Aa'].done_as == aa
+    assert tracker.violations() == []
+
+
+def test_a_robot_whose_own_end_is_not_reported_completes_nothing_by_arriving(planned):
+    """Its own report of the job comes before its arrival elsewhere (one writer): without
+    it, the arrival proves nothing yet."""
+    tracker, _, aa, holders = reach_aa_with_one_report_missing(planned, mover_done=False)
+    verdict = tracker.record_event('mover/Jb/arrived', EventKind.ARRIVED, holders[0], 'Jb', 1,
+                                   float(aa.end))
+    assert verdict.job_done is None and 'Aa' in tracker.running
