@@ -10,6 +10,10 @@ never raised: a message must not crash the planner.
 
 A plan revision either continues a job (it was under way) or starts it afresh: reports about
 a job made under a revision older than the one that last started it no longer count.
+
+A job is complete when every robot on it reported its operation done, or as soon as one of
+them, having reported its own, arrives at its next job: agents leave a job only once it is
+complete, so a robot is never counted on two jobs at once for want of a late report.
 """
 
 import dataclasses
