@@ -102,10 +102,14 @@ def test_cancel_leaves_the_fleet_idle_for_the_next_mission(client, observer):
     assert result.state == 'cancelled' and result.jobs_done < 12
     observer.wait_for(lambda o: o.status.state == MissionStatus.STATE_CANCELLED
                       and fleet_is_idle(o), 15, 'an idle fleet')
+    # Every operation started ended: done, or aborted because the mission was cancelled.
     _, events = of_mission(observer, mission.mission_id)
-    assert any(e.kind == TaskEvent.KIND_ABORTED and e.reason == 'mission cancelled'
-               for e in events) or not any(e.kind == TaskEvent.KIND_STARTED
-                                           for e in events[-4:])
+    ended = {(e.robot, e.job): e for e in events
+             if e.kind in (TaskEvent.KIND_OPERATION_DONE, TaskEvent.KIND_ABORTED)}
+    for start in (e for e in events if e.kind == TaskEvent.KIND_STARTED):
+        end = ended.get((start.robot, start.job))
+        assert end is not None, f'{start.robot} never ended {start.job}'
+        assert end.kind == TaskEvent.KIND_OPERATION_DONE or end.reason == 'mission cancelled', end
     third = client.run(PAPER, timeout=90)
     assert third.complete and third.jobs_done == 12
     check_done_once(load_scenario(PAPER), observer, third.mission_id)
