@@ -620,3 +620,18 @@ def test_improve_from_a_frozen_plan_starts_nothing_new_before_it_reaches_the_rob
         else:
             assert schedule.jobs[name].start >= until
     assert 32 <= schedule.makespan <= repaired.schedule.makespan
+
+
+def test_a_kept_jig_job_keeps_the_index_of_the_plan_it_ran():
+    """J ran its second plan (A holds alone) when C fails: the kept J is pinned under that
+    plan's index, as the published plan and the robots name it, not under a new one."""
+    problem = replace(make_problem(), jobs=(Job('J', 'p', ((0, 0), (0,))),
+                                            *make_problem().jobs[1:]))
+    plan = replace(PLAN, jobs={**PLAN.jobs, 'J': replace(PLAN.jobs['J'], plan=1)})
+    residual = residual_problem(problem, at(problem, Fraction(5, 2), {'C'}, plan), plan)
+    p = residual.problem
+    assert residual.kept == ['J']
+    assert p.fixed['J'].plan == 1 and p.job('J').plans[1] == (0,)
+    outcome = replan(problem, plan, at(problem, Fraction(5, 2), {'C'}, plan), time_limit=2)
+    assert outcome.schedule.jobs['J'].plan == 1
+    assert validate(outcome.residual.problem, outcome.schedule) == []

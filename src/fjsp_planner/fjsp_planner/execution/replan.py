@@ -390,11 +390,11 @@ def residual_problem(problem: Problem, state: ExecutionState,
               if not set(h.holders) <= healthy or h.source in release or _lost(h, state)}
     aborted.update(h.target for h in holds if h.source in voided and h.target in state.running)
     fixed = {name: a for name, a in state.running.items() if name not in aborted}
-    kept, began, carried_to = {}, {}, {}
+    kept, jigs, carried_to = {}, {}, {}
     for h in holds:
         if h.source not in voided and h.target not in fixed:
             kept.setdefault(h.source, {}).update(h.holders)
-            began[h.source] = h.began
+            jigs[h.source] = (h.began, h.plan)
             carried_to.update(dict.fromkeys(h.holders, h.target))
     _raise_on_hold_conflicts(holds, kept, state.running)
 
@@ -411,7 +411,7 @@ def residual_problem(problem: Problem, state: ExecutionState,
     blocked = _staffing_problems(problem, todo, healthy, kept, residual.failed)
     if blocked:
         return replace(residual, blocked=blocked)
-    posed = _pose(problem, state, healthy, todo, fixed, kept, began, carried_to, aborted)
+    posed = _pose(problem, state, healthy, todo, fixed, kept, jigs, carried_to, aborted)
     return replace(residual, problem=posed)
 
 
@@ -425,6 +425,8 @@ class _Hold:
     holders: dict[str, int]
     began: Fraction
     """When the source started, or at the latest could have."""
+    plan: int | None
+    """The source's plan, when known (the target's holders tell who, not which plan)."""
 
 
 def _open_holds(problem, state, previous) -> list[_Hold]:
@@ -437,11 +439,13 @@ def _open_holds(problem, state, previous) -> list[_Hold]:
         if source not in state.done or target in state.done:
             continue
         if source in state.done_as:
-            robots, began = state.done_as[source].robots, state.done_as[source].start
+            done = state.done_as[source]
+            robots, began, plan = done.robots, done.start, done.plan
         elif previous is not None and source in previous.jobs:
-            robots, began = previous.jobs[source].robots, previous.jobs[source].start
+            done = previous.jobs[source]
+            robots, began, plan = done.robots, done.start, done.plan
         elif target in state.running:
-            robots, began = state.running[target].robots, None
+            robots, began, plan = state.running[target].robots, None, None
         else:
             raise ValueError(f"job '{source}' is done and holds for '{target}', which is "
                              f'not: pass the schedule being executed as `previous` to tell '
@@ -453,7 +457,7 @@ def _open_holds(problem, state, previous) -> list[_Hold]:
         holders = {r: t for r, t in robots.items() if t == q}
         if began is None:
             began = state.running[target].start - _longest(problem, holders)
-        holds.append(_Hold(source, target, holders, began))
+        holds.append(_Hold(source, target, holders, began, plan))
     return holds
 
 
@@ -532,8 +536,9 @@ def _named(robots: Mapping[str, int]) -> str:
     return ', '.join(f"'{r}'" for r in sorted(robots))
 
 
-def _pose(problem, state, healthy, todo, fixed, kept, began, carried_to, aborted) -> Problem:
-    """The residual `Problem`: todo + fixed running + kept jig jobs, healthy robots only."""
+def _pose(problem, state, healthy, todo, fixed, kept, jigs, carried_to, aborted) -> Problem:
+    """The residual `Problem`: todo + fixed running + kept jig jobs, healthy robots only.
+    `jigs`: kept jig job -> (when it began, its plan or None if unknown)."""
     now = state.now
     place = {}
     for name, a in fixed.items():
@@ -572,13 +577,17 @@ def _pose(problem, state, healthy, todo, fixed, kept, began, carried_to, aborted
     pinned = {name: FixedJob(a.plan, a.start, max(a.end, now), dict(a.robots))
               for name, a in fixed.items()}
     for name, holders in kept.items():
-        # Only the holders are still bound to the jig job: a plan of just their operations
-        # keeps the fixed job consistent, and lets its other robots go on freely.
+        # Only the holders are still bound to the jig job: its plan becomes just their
+        # operations, which keeps the fixed job consistent and lets its other robots go on
+        # freely. It keeps its index, which the published plan and the robots go by.
         job = problem.job(name)
-        jobs.append(Job(job.name, job.location, (tuple(sorted(holders.values())),)))
+        held_since, plan = jigs[name]
+        ops = tuple(sorted(holders.values()))
+        plans = (ops,) if plan is None else job.plans[:plan] + (ops,) + job.plans[plan + 1:]
+        jobs.append(Job(job.name, job.location, plans))
         end = _hold_end(problem, state, name, holders, carried_to)
-        start = min(began[name], end - _longest(problem, holders))
-        pinned[name] = FixedJob(0, start, end, dict(holders))
+        start = min(held_since, end - _longest(problem, holders))
+        pinned[name] = FixedJob(plan or 0, start, end, dict(holders))
     names = {j.name for j in jobs}
     scheduled = {j.name for j in todo}
     precedence = tuple((a, b) for a, b in problem.precedence if a in names and b in scheduled)
