@@ -1,10 +1,13 @@
-"""Makes the domain core importable from the source tree, so its tests need no build, and
-draws the run's seed for the property tests on generated scenarios (`generated_seeds`)."""
+"""Makes the domain core importable from the source tree, so its tests need no build, draws
+the run's seed for the property tests on generated scenarios (`generated_seeds`), and hands
+out the longest files first."""
 
 import os
 import random
 import sys
 from pathlib import Path
+
+import pytest
 
 REPO = Path(__file__).resolve().parent.parent
 for package in ('fjsp_common', 'fjsp_planner', 'robot_agents'):
@@ -23,3 +26,24 @@ def pytest_configure(config):
 def pytest_report_header(config):
     return (f'generated scenarios: {SEED_VARIABLE}={os.environ[SEED_VARIABLE]} '
             '(set it to repeat this run)')
+
+
+LONGEST_FIRST = (
+    'solving/test_known_optima.py', 'integration/test_soak.py',
+    'integration/test_mission_service.py', 'integration/test_robot_drivers.py',
+    'integration/test_ros2_front_end.py', 'solving/bounds/test_bounds.py',
+    'integration/test_missions.py', 'integration/test_failure_modes.py',
+    'integration/test_generated_fleets.py', 'integration/test_restarts.py',
+    'integration/test_fleet_respawn.py', 'integration/test_observe.py',
+    'execution/mission/test_states.py', 'integration/test_fleet_cli.py', 'test_cli.py',
+)
+"""The files that take longest in a whole run. pytest-xdist hands out whole files in the
+order collected: these go first, so that no long file starts last while the other processes
+run out of work."""
+
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_collection_modifyitems(items) -> None:
+    rank = {name: i for i, name in enumerate(LONGEST_FIRST)}
+    root = Path(__file__).resolve().parent
+    items.sort(key=lambda item: rank.get(item.path.relative_to(root).as_posix(), len(rank)))
