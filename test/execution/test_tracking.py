@@ -8,7 +8,13 @@ from fractions import Fraction
 import pytest
 
 from fjsp_planner.execution.replan import replan, residual_problem, simulated_state
-from fjsp_planner.execution.tracking import ROBOT_EVENTS, EventKind, Ignored, MissionTracker
+from fjsp_planner.execution.tracking import (
+    ROBOT_EVENTS,
+    EventKind,
+    Ignored,
+    MissionTracker,
+    latest_departure,
+)
 from fjsp_planner.model.generator import Shape, random_scenario
 from fjsp_planner.model.problem import Job, Problem, Robot
 from fjsp_planner.model.scenario import load_scenario, parse_scenario
@@ -845,3 +851,14 @@ def test_a_robot_whose_own_end_is_not_reported_completes_nothing_by_arriving(pla
     verdict = tracker.record_event('mover/Jb/arrived', EventKind.ARRIVED, holders[0], 'Jb', 1,
                                    float(aa.end))
     assert verdict.job_done is None and 'Aa' in tracker.running
+
+
+def test_a_departure_read_back_from_an_arrival_fits_its_leg_exactly():
+    """14.575008 - 1.2 in floats rounds up (13.375008 + 6/5 > 14.575008 exactly): a job
+    ended so would break the executed timeline of the robot that left it."""
+    leg = Fraction(6, 5)
+    assert Fraction(14.575008 - 1.2) + leg > Fraction(14.575008)
+    departure = latest_departure(14.575008, leg)
+    assert Fraction(departure) + leg <= Fraction(14.575008)
+    assert Fraction(math.nextafter(departure, math.inf)) + leg > Fraction(14.575008)
+    assert latest_departure(3.0, Fraction(1)) == 2.0

@@ -244,7 +244,7 @@ class MissionTracker:
         arrival = here.arrived.get(robot, here.started.get(robot))
         leg = self.problem.travel(robot, self.problem.job(before).location,
                                   self.problem.job(job).location)
-        end = max(arrival - float(leg), *record.operation_done.values())
+        end = max(latest_departure(arrival, leg), *record.operation_done.values())
         self._complete(before, end)
         return before, end
 
@@ -657,6 +657,15 @@ class MissionTracker:
             holding=tuple((a, b, q) for a, b, q in p.holding if a in done and b in done),
             distances=relaxed_distances(p, executed), fixed={}, panels=(),
             name=f'{p.name} as executed')
+
+
+def latest_departure(arrival: float, leg: Fraction) -> float:
+    """The latest time, as a float, a robot arriving at `arrival` after a leg of `leg` can
+    have set off. The executed timeline is checked in exact arithmetic, and `arrival - leg`
+    in floats may round above the exact difference: a departure after the arrival allows."""
+    exact = Fraction(arrival) - leg
+    departure = float(exact)
+    return departure if Fraction(departure) <= exact else math.nextafter(departure, -math.inf)
 
 
 def without_durations(problem: Problem) -> Problem:
