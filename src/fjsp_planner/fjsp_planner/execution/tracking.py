@@ -67,6 +67,8 @@ class JobRecord:
     """A robot on it failed while working: it waits for a new revision to be redone."""
     done_as: JobAssignment | None = None
     """The plan and robots it was completed with."""
+    left: bool = False
+    """Completed by a robot's arrival at its next job, before every report of it came."""
 
     @property
     def start(self) -> float | None:
@@ -194,6 +196,11 @@ class MissionTracker:
                 return Verdict()
             self.jobs[job] = JobRecord(job, since_revision=record.since_revision, aborted=True)
             return Verdict()
+        if record.end is not None and record.left and robot not in facts[kind]:
+            # A report of a job its robots had left, late behind their arrivals elsewhere:
+            # kept, though the job is complete, and not counted as ignored.
+            facts[kind][robot] = time
+            return Verdict()
         if robot in facts[kind] or record.end is not None:
             self.ignored[Ignored.DUPLICATE] += 1
             return Verdict(Ignored.DUPLICATE, f"'{robot}' already reported {kind} for job "
@@ -246,6 +253,7 @@ class MissionTracker:
                                   self.problem.job(job).location)
         end = max(latest_departure(arrival, leg), *record.operation_done.values())
         self._complete(before, end)
+        record.left = True
         return before, end
 
     def _check_event(self, event_id, kind, robot, job, revision, time) -> Verdict | None:
