@@ -8,13 +8,7 @@ from fractions import Fraction
 import pytest
 
 from fjsp_planner.execution.replan import replan, residual_problem, simulated_state
-from fjsp_planner.execution.tracking import (
-    ROBOT_EVENTS,
-    EventKind,
-    Ignored,
-    MissionTracker,
-    latest_departure,
-)
+from fjsp_planner.execution.tracking import ROBOT_EVENTS, EventKind, Ignored, MissionTracker
 from fjsp_planner.model.generator import Shape, random_scenario
 from fjsp_planner.model.problem import Job, Problem, Robot
 from fjsp_planner.model.scenario import load_scenario, parse_scenario
@@ -805,66 +799,3 @@ def test_the_projection_never_reads_below_the_optimum_of_an_executed_mission(
                                                                        abs=1e-9), now
         assert replanned.makespan >= least
     assert tracker.complete
-
-
-def reach_aa_with_one_report_missing(planned, mover_done=True):
-    """Aa under way, every operation on it done but the welder's, whose report is missing;
-    its holders may go on to Jb. The tracker, the plan, Aa and the holders."""
-    problem, schedule = planned
-    tracker = MissionTracker(problem)
-    tracker.set_plan(schedule, 1)
-    aa = schedule.jobs['Aa']
-    run_plan(tracker, schedule, until=aa.start)
-    holders = [r for r in aa.robots if r in schedule.jobs['Ja'].robots]
-    for robot in aa.robots:
-        tracker.record_event(f'{robot}/Aa/started', EventKind.STARTED, robot, 'Aa', 1,
-                             float(aa.start))
-    for robot in holders if mover_done else holders[1:]:
-        tracker.record_event(f'{robot}/Aa/done', EventKind.OPERATION_DONE, robot, 'Aa', 1,
-                             float(aa.start + problem.duration(robot, aa.robots[robot])))
-    return tracker, schedule, aa, holders
-
-
-def test_a_robots_arrival_at_its_next_job_completes_the_job_it_left(planned):
-    """A robot leaves a job only once every robot on it is done: its arrival at its next job
-    completes the job, at the arrival less the leg, though a report of it is missing."""
-    tracker, schedule, aa, holders = reach_aa_with_one_report_missing(planned)
-    mover = holders[0]
-    assert schedule.sequences[mover][schedule.sequences[mover].index('Aa') + 1] == 'Jb'
-    leg = tracker.problem.travel(mover, 'Aa', 'Jb')
-    verdict = tracker.record_event('mover/Jb/arrived', EventKind.ARRIVED, mover, 'Jb', 1,
-                                   float(aa.end + leg))
-    assert verdict.job_done == ('Aa', float(aa.end))
-    assert 'Aa' in tracker.done and 'Aa' not in tracker.running
-    assert tracker.jobs['Aa'].done_as == aa
-    (welder,) = set(aa.robots) - set(holders)
-    # The welder's own report, late behind the mover's arrival, is no duplicate: kept, the
-    # job as it was completed; only a second one is.
-    late = tracker.record_event('welder/Aa/done', EventKind.OPERATION_DONE, welder, 'Aa', 1,
-                                float(aa.end))
-    assert late.ignored is None and late.job_done is None
-    assert tracker.jobs['Aa'].done_as == aa and tracker.ignored[Ignored.DUPLICATE] == 0
-    again = tracker.record_event('welder/Aa/done2', EventKind.OPERATION_DONE, welder, 'Aa', 1,
-                                 float(aa.end))
-    assert again.ignored == Ignored.DUPLICATE
-    assert tracker.violations() == []
-
-
-def test_a_robot_whose_own_end_is_not_reported_completes_nothing_by_arriving(planned):
-    """Its own report of the job comes before its arrival elsewhere (one writer): without
-    it, the arrival proves nothing yet."""
-    tracker, _, aa, holders = reach_aa_with_one_report_missing(planned, mover_done=False)
-    verdict = tracker.record_event('mover/Jb/arrived', EventKind.ARRIVED, holders[0], 'Jb', 1,
-                                   float(aa.end))
-    assert verdict.job_done is None and 'Aa' in tracker.running
-
-
-def test_a_departure_read_back_from_an_arrival_fits_its_leg_exactly():
-    """14.575008 - 1.2 in floats rounds up (13.375008 + 6/5 > 14.575008 exactly): a job
-    ended so would break the executed timeline of the robot that left it."""
-    leg = Fraction(6, 5)
-    assert Fraction(14.575008 - 1.2) + leg > Fraction(14.575008)
-    departure = latest_departure(14.575008, leg)
-    assert Fraction(departure) + leg <= Fraction(14.575008)
-    assert Fraction(math.nextafter(departure, math.inf)) + leg > Fraction(14.575008)
-    assert latest_departure(3.0, Fraction(1)) == 2.0
