@@ -799,3 +799,85 @@ def test_the_projection_never_reads_below_the_optimum_of_an_executed_mission(
                                                                        abs=1e-9), now
         assert replanned.makespan >= least
     assert tracker.complete
+
+
+def reach_aa_with_one_report_missing(planned, mover_done=True):
+    """Aa under way, every operation on it done but the welder's, whose report is missing;
+    its holders may go on to Jb. The tracker, the plan, Aa and the holders."""
+    problem, schedule = planned
+    tracker = MissionTracker(problem)
+    tracker.set_plan(schedule, 1)
+    aa = schedule.jobs['Aa']
+    run_plan(tracker, schedule, until=aa.start)
+    holders = [r for r in aa.robots if r in schedule.jobs['Ja'].robots]
+    for robot in aa.robots:
+        tracker.record_event(f'{robot}/Aa/started', EventKind.STARTED, robot, 'Aa', 1,
+                             float(aa.start))
+    for robot in holders if mover_done else holders[1:]:
+        tracker.record_event(f'{robot}/Aa/done', EventKind.OPERATION_DONE, robot, 'Aa', 1,
+                             float(aa.start + problem.duration(robot, aa.robots[robot])))
+    return tracker, schedule, aa, holders
+
+
+def reported_end(tracker, job):
+    return max(tracker.jobs[job].operation_done.values())
+
+
+def test_a_robots_arrival_at_its_next_job_completes_the_job_it_left(planned):
+    """A robot leaves a job only once every robot on it is done: its arrival at its next job
+    completes the job, though a report of it is missing, ended at the latest report that
+    came (the missing one may say later; no robot left before it)."""
+    tracker, schedule, aa, holders = reach_aa_with_one_report_missing(planned)
+    mover = holders[0]
+    assert schedule.sequences[mover][schedule.sequences[mover].index('Aa') + 1] == 'Jb'
+    leg = tracker.problem.travel(mover, 'Aa', 'Jb')
+    end = reported_end(tracker, 'Aa')
+    verdict = tracker.record_event('mover/Jb/arrived', EventKind.ARRIVED, mover, 'Jb', 1,
+                                   float(aa.end + leg))
+    assert verdict.job_done == ('Aa', end)
+    assert 'Aa' in tracker.done and 'Aa' not in tracker.running
+    done_as = tracker.jobs['Aa'].done_as
+    assert (done_as.start, done_as.end, done_as.robots) == (aa.start, Fraction(end), aa.robots)
+    (welder,) = set(aa.robots) - set(holders)
+    # The welder's own report, late behind the mover's arrival, is no duplicate: kept, the
+    # job as it was completed; only a second one is.
+    late = tracker.record_event('welder/Aa/done', EventKind.OPERATION_DONE, welder, 'Aa', 1,
+                                float(aa.end))
+    assert late.ignored is None and late.job_done is None
+    assert tracker.jobs['Aa'].done_as == done_as and tracker.ignored[Ignored.DUPLICATE] == 0
+    again = tracker.record_event('welder/Aa/done2', EventKind.OPERATION_DONE, welder, 'Aa', 1,
+                                 float(aa.end))
+    assert again.ignored == Ignored.DUPLICATE
+    assert tracker.violations() == []
+
+
+def test_a_job_completed_by_an_arrival_ends_before_any_of_its_robots_left(planned):
+    """The mover set off late (its plan had it wait) and arrives well after the job ended;
+    the robot whose report was missing left at the true end and reaches its own next job
+    first. The job's end is read from the reports, not back from the late arrival, so the
+    executed timeline holds both robots' legs."""
+    tracker, schedule, aa, holders = reach_aa_with_one_report_missing(planned)
+    (welder,) = set(aa.robots) - set(holders)
+    sequence = schedule.sequences[welder]
+    following = sequence[sequence.index('Aa') + 1]
+    mover = holders[0]
+    leg = tracker.problem.travel(mover, 'Aa', 'Jb')
+    verdict = tracker.record_event('mover/Jb/arrived', EventKind.ARRIVED, mover, 'Jb', 1,
+                                   float(aa.end + leg + 5))
+    assert verdict.job_done is not None
+    tracker.record_event('welder/Aa/done', EventKind.OPERATION_DONE, welder, 'Aa', 1,
+                         float(aa.end))
+    welder_leg = tracker.problem.travel(welder, 'Aa', following)
+    tracker.record_event('welder/next/arrived', EventKind.ARRIVED, welder, following, 1,
+                         float(aa.end + welder_leg))
+    assert tracker.jobs['Aa'].end <= float(aa.end)
+    assert tracker.violations() == []
+
+
+def test_a_robot_whose_own_end_is_not_reported_completes_nothing_by_arriving(planned):
+    """Its own report of the job comes before its arrival elsewhere (one writer): without
+    it, the arrival proves nothing yet."""
+    tracker, _, aa, holders = reach_aa_with_one_report_missing(planned, mover_done=False)
+    verdict = tracker.record_event('mover/Jb/arrived', EventKind.ARRIVED, holders[0], 'Jb', 1,
+                                   float(aa.end))
+    assert verdict.job_done is None and 'Aa' in tracker.running
