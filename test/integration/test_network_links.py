@@ -14,7 +14,9 @@ import time
 import pytest
 
 from fjsp_common.contract import LATCHED_QOS, MISSION_STATUS_TOPIC
+from fjsp_common.fleet import HEARTBEAT_TIMEOUT
 from fjsp_msgs.msg import MissionEvent, MissionStatus, TaskEvent
+from fjsp_planner.execution.mission.liveness import FLEET_SILENCE
 
 from repo_paths import PAPER
 
@@ -135,7 +137,9 @@ def test_the_planner_cut_off_from_every_robot(lan_fleet):
     fleet.wait_for(lambda o: o.status is not None and o.status.jobs_done >= 3, 60,
                    'the mission under way')
     fleet.cut('planner')
-    time.sleep(3.0)  # longer than the heartbeat timeout: every robot is offline to it
+    # Longer than the planner waits when no robot at all is heard: every robot is offline to
+    # it.
+    time.sleep(FLEET_SILENCE * HEARTBEAT_TIMEOUT + 1.5)
     fleet.restore('planner')
     fleet.wait_for(lambda o: o.status.state == MissionStatus.STATE_BLOCKED or any(
         story(o, MissionEvent.KIND_ROBOT_OFFLINE, r) for r in ('MARC1', 'LSMS')), 20,

@@ -388,6 +388,36 @@ def test_a_starved_executor_does_not_make_robots_offline(problem):
                      MissionEventKind.ROBOT_OFFLINE)
 
 
+def test_robots_heard_late_all_together_are_not_offline(problem):
+    """Every robot's states stop arriving for 1.5 s while the planner ticks (a flood it reads
+    behind, a core it waits for), then all come at once: the planner fell behind, no robot
+    failed, and nothing is re-planned."""
+    fleet = executing(problem)
+    effects = fleet.tick(advance=1.5, robots=())
+    effects += fleet.tick()
+    assert not notes(effects, MissionEventKind.ROBOT_OFFLINE)
+    assert not kinds(effects, Solve)
+
+
+def test_a_robot_silent_while_the_others_are_heard_is_offline_after_the_timeout(problem):
+    fleet = executing(problem)
+    assert not notes(fleet.tick(advance=0.9, robots=ROBOTS[1:]), MissionEventKind.ROBOT_OFFLINE)
+    effects = fleet.tick(advance=0.3, robots=ROBOTS[1:])
+    assert [n.robot for n in notes(effects, MissionEventKind.ROBOT_OFFLINE)] == [ROBOTS[0]]
+
+
+def test_a_fleet_that_falls_silent_together_is_offline_after_three_timeouts(problem):
+    """No robot heard at all: the planner cannot tell its own stall from the fleet's loss (a
+    cut link), and waits longer before it plans without every robot."""
+    fleet = executing(problem)
+    assert not notes(fleet.tick(advance=2.9, robots=()), MissionEventKind.ROBOT_OFFLINE)
+    effects = fleet.tick(advance=0.3, robots=())
+    assert sorted(n.robot for n in notes(effects, MissionEventKind.ROBOT_OFFLINE)) \
+        == sorted(ROBOTS)
+    fleet.run_solves()
+    assert fleet.state() == MissionState.BLOCKED
+
+
 def test_executed_mission_completes(problem):
     fleet = executing(problem)
     fleet.execute()

@@ -18,6 +18,7 @@ from fjsp_common.vocabulary import EventKind, MissionState, RobotMode
 from fjsp_planner.execution.journal import PlanRecord
 from fjsp_planner.execution.mission.controller import MissionController
 from fjsp_planner.execution.mission.effects import PublishPlan, Solve, SolveKind
+from fjsp_planner.execution.mission.liveness import FLEET_SILENCE
 from fjsp_planner.execution.mission.reports import EventReport, RobotReport
 from fjsp_planner.execution.mission.settings import Settings
 from fjsp_planner.execution.replan import replan
@@ -29,6 +30,8 @@ from repo_paths import SCENARIOS
 
 SCENARIO = SCENARIOS / 'solar_panel.yaml'
 ROBOTS = ('Assembler', 'LSMS', 'MARC1', 'MARC2')
+FLEET_SILENT = FLEET_SILENCE * 1.0 + 0.5
+"""Seconds of no robot heard at all after which every robot is offline (timeout 1 s)."""
 SETTINGS = Settings(time_limit=5.0, replan_time_limit=2.0, heartbeat_timeout=1.0,
                     robot_wait_timeout=3.0, start_delay=0.0, time_scale=1.0)
 
@@ -111,7 +114,7 @@ def test_a_replan_on_a_half_arrived_history_is_retried_once_it_has_arrived(plann
     for robot in crew:
         planner.event(EventKind.STARTED, robot, 'Ja', start)
     # The link is cut. On the other side Ja is finished, Aa begun, and a robot of Ja fails.
-    planner.tick(1.5, heard=())
+    planner.tick(FLEET_SILENT, heard=())
     planner.solve_pending()
     assert planner.mission.state == MissionState.BLOCKED  # nobody left to do anything
     failing = next(iter(crew))
@@ -157,7 +160,7 @@ def test_a_mission_completed_while_blocked_no_longer_says_it_is_blocked(planner)
     """The planner cut off from every robot blocks the mission (nobody to staff anything);
     the robots, unaware, finish the plan they have, and their reports complete it. Its
     status said COMPLETE with the reasons of the old block (soak and network tests)."""
-    planner.tick(1.5, heard=())
+    planner.tick(FLEET_SILENT, heard=())
     planner.solve_pending()
     assert planner.mission.state == MissionState.BLOCKED
     plan, problem = planner.mission.schedule, planner.mission.problem

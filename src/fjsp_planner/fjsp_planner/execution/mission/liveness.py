@@ -5,9 +5,13 @@ failed nor offline, and it follows the plans it is given (an agent that refuses 
 for a robot type it cannot play, is left out and named in the warnings; so is one that keeps
 reporting an older revision than the latest, which it may never have received, until it
 reports the latest). A robot whose heartbeat is lost is offline until it has been heard again
-for a full heartbeat timeout, so that one late heartbeat does not re-plan twice. States that
-do not verify with the fleet key are no heartbeat, but they are remembered: a robot whose
-agent lacks the key is said to be unverified rather than merely silent.
+for a full heartbeat timeout, so that one late heartbeat does not re-plan twice. A heartbeat is
+lost when the robot has not been heard for a timeout longer than the robot heard last: states
+that all come late together tell of a planner that could not read them (a flood, a stalled
+core), not of failed robots. When no robot at all is heard, they go offline after
+FLEET_SILENCE timeouts: the planner cannot tell its own stall from a fleet-wide loss then.
+States that do not verify with the fleet key are no heartbeat, but they are remembered: a
+robot whose agent lacks the key is said to be unverified rather than merely silent.
 """
 
 import math
@@ -31,6 +35,9 @@ PLAN_RESEND_AFTER = 2.0
 the plan is published again, on a new writer: a sample lost on a matched subscription is
 resent by the reliable writer long before, so the robot's subscription is likely not matched
 to the writer at all."""
+
+FLEET_SILENCE = 3
+"""Heartbeat timeouts after which robots are offline although no robot was heard since."""
 
 STARVED = 0.25
 """Seconds between two ticks beyond which the node could not take messages for a while: the
@@ -138,12 +145,15 @@ class Liveness:
         return starved
 
     def check_heartbeats(self, wall: float, timeout: float) -> list[HeartbeatChange]:
-        """The agents that went offline at `wall` (no state for more than `timeout`) and those
-        that count again (heard for a full `timeout` after an offline spell)."""
+        """The agents that went offline at `wall` (no state for more than `timeout` before the
+        latest state of any robot, or for FLEET_SILENCE timeouts) and those that count again
+        (heard for a full `timeout` after an offline spell)."""
         changes = []
+        latest = max((agent.heard for agent in self.agents.values()), default=wall)
         for name, agent in self.agents.items():
             silent = wall - agent.heard
-            if agent.offline_since is None and silent > timeout:
+            lost = latest - agent.heard > timeout or silent > FLEET_SILENCE * timeout
+            if agent.offline_since is None and lost:
                 agent.offline_since, agent.back_since = wall, None
                 changes.append(HeartbeatChange(name, False, silent))
             elif agent.back_since is not None and silent <= timeout \

@@ -26,7 +26,8 @@ PARAMETERS = table(
                   high=600.0, read_only=False),
     ParameterSpec('workers', 2, 'CP-SAT search workers', low=1, high=64, read_only=False),
     ParameterSpec('heartbeat_timeout', HEARTBEAT_TIMEOUT,
-                  'seconds without a robot state before a robot is offline', low=0.05,
+                  'seconds without a robot state, while others are heard, before a robot is '
+                  'offline (three times as long when none is)', low=0.05,
                   high=600.0, read_only=False),
     ParameterSpec('delay_threshold', 2.0,
                   'schedule units an operation may run late before a re-plan', low=0.0,
