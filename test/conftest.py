@@ -35,7 +35,7 @@ LONGEST_FIRST = (
     'integration/test_missions.py', 'integration/test_failure_modes.py',
     'integration/test_generated_fleets.py', 'integration/test_restarts.py',
     'integration/test_fleet_respawn.py', 'integration/test_observe.py',
-    'execution/mission/test_states.py', 'integration/test_fleet_cli.py', 'test_cli.py',
+    'integration/test_fleet_cli.py', 'test_cli.py',
 )
 """The files that take longest in a whole run. pytest-xdist hands out whole files in the
 order collected: these go first, so that no long file starts last while the other processes

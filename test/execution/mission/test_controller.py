@@ -1,7 +1,9 @@
 """The mission controller's decisions, driven by hand-made reports and a fake clock (no ROS).
 
 The paper's instance: its optimum (32) is found in well under a second, so every solve the
-controller asks for is run here for real, through the same functions the node calls.
+controller asks for is run here for real, through the same functions the node calls. The
+moves of mission state they make are recorded: together they are every move the state table
+(`states.TRANSITIONS`) allows, which the last test checks.
 """
 
 import re
@@ -11,6 +13,7 @@ from fractions import Fraction
 import pytest
 
 from fjsp_common.vocabulary import EventKind, MissionEventKind, MissionState, RobotMode
+from fjsp_planner.execution.mission import controller
 from fjsp_planner.execution.mission.continuation import DUE_GRACE
 from fjsp_planner.execution.mission.controller import IMPROVE_REACH, MissionController
 from fjsp_planner.execution.mission.effects import (
@@ -25,6 +28,7 @@ from fjsp_planner.execution.mission.effects import (
 from fjsp_planner.execution.mission.liveness import PLAN_RESEND_AFTER
 from fjsp_planner.execution.mission.reports import EventReport, RobotReport
 from fjsp_planner.execution.mission.settings import Settings
+from fjsp_planner.execution.mission.states import TRANSITIONS, check_transition
 from fjsp_planner.execution.replan import Improvement, Replan, improve, repair
 from fjsp_planner.model.scenario import load_scenario
 from fjsp_planner.model.schedule import Schedule
@@ -35,6 +39,23 @@ from repo_paths import PAPER
 ROBOTS = ('Assembler', 'LSMS', 'MARC1', 'MARC2')
 SETTINGS = Settings(time_limit=5.0, replan_time_limit=2.0, heartbeat_timeout=1.0,
                     robot_wait_timeout=3.0, start_delay=0.0, time_scale=1.0)
+
+
+MOVES: set[tuple[MissionState, MissionState]] = set()
+"""Every move of a mission's state that this file's tests made (current, new)."""
+RAN: set[str] = set()
+"""The tests of this file that ran in this process."""
+
+
+@pytest.fixture(autouse=True)
+def record_moves(request, monkeypatch):
+    def recording(current, new):
+        MOVES.add((current, new))
+        return check_transition(current, new)
+
+    monkeypatch.setattr(controller, 'check_transition', recording)
+    yield
+    RAN.add(request.node.nodeid)
 
 
 @pytest.fixture(scope='module')
@@ -408,7 +429,8 @@ def test_a_robot_silent_while_the_others_are_heard_is_offline_after_the_timeout(
 
 def test_a_fleet_that_falls_silent_together_is_offline_after_three_timeouts(problem):
     """No robot heard at all: the planner cannot tell its own stall from the fleet's loss (a
-    cut link), and waits longer before it plans without every robot."""
+    cut link), and waits longer before it plans without every robot. The robots, unaware,
+    finish the plan they have: their reports complete the mission."""
     fleet = executing(problem)
     assert not notes(fleet.tick(advance=2.9, robots=()), MissionEventKind.ROBOT_OFFLINE)
     effects = fleet.tick(advance=0.3, robots=())
@@ -416,6 +438,8 @@ def test_a_fleet_that_falls_silent_together_is_offline_after_three_timeouts(prob
         == sorted(ROBOTS)
     fleet.run_solves()
     assert fleet.state() == MissionState.BLOCKED
+    fleet.execute()
+    assert fleet.state() == MissionState.COMPLETE
 
 
 def test_executed_mission_completes(problem):
@@ -1410,3 +1434,15 @@ def test_a_robot_whose_states_do_not_verify_is_named_so_not_merely_silent(proble
     assert offline.reasons[0].endswith('s: not signed')
     assert "robot 'MARC2' sends states that do not verify: not signed" in \
         kinds(fleet.effects, Solve)[-1].reasons
+
+
+def test_the_missions_here_make_exactly_the_moves_the_state_table_allows(request):
+    """Last in this file: the table allows no move that no mission here makes (an illegal one
+    raises as it is made). Checked when every other test of the file ran before it, in this
+    process."""
+    others = {item.nodeid for item in request.node.parent.collect()} - {request.node.nodeid}
+    if not others <= RAN:
+        pytest.skip('needs every test of this file run before it in this process')
+    moves = {(current, new) for current, new in MOVES if current != new}
+    assert moves == {(current, new) for current, allowed in TRANSITIONS.items()
+                     for new in allowed}
