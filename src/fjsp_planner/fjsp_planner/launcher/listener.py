@@ -32,6 +32,7 @@ class Listener:
             rclpy.try_shutdown(context=self.context)
             raise
         self.lock = threading.Condition()
+        self._stopping = threading.Event()
         self.executor = SingleThreadedExecutor(context=self.context)
         self.executor.add_node(self.node)
         self.thread = threading.Thread(target=self._spin, name=name, daemon=True)
@@ -39,7 +40,7 @@ class Listener:
 
     def _spin(self) -> None:
         try:
-            while self.context.ok():
+            while self.context.ok() and not self._stopping.is_set():
                 self.executor.spin_once(timeout_sec=0.1)
         except ExternalShutdownException:
             pass
@@ -61,10 +62,15 @@ class Listener:
             return self.lock.wait_for(predicate, timeout=timeout)
 
     def close(self) -> None:
+        # The spinning thread stops before anything it waits on is destroyed: destroying the
+        # node under a wait can leave that thread blocked in rclpy holding the interpreter,
+        # and the join below, hence the caller, waiting for ever.
+        self._stopping.set()
+        self.executor.wake()
+        self.thread.join(timeout=2.0)
         self.executor.shutdown(timeout_sec=1.0)
         self.node.destroy_node()
         rclpy.try_shutdown(context=self.context)
-        self.thread.join(timeout=2.0)
 
 
 @contextmanager
