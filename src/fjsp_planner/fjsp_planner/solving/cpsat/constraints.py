@@ -84,7 +84,7 @@ def holding(m, problem: Problem, jobs: JobVariables, route: RouteVariables):
 
 
 def makespan_covers_work(m, problem: Problem, grid: TimeGrid, jobs: JobVariables, makespan,
-                         legs):
+                         legs) -> dict:
     """A robot's release time, the jobs it does and one leg into each place it works at fit
     before the makespan.
 
@@ -95,7 +95,10 @@ def makespan_covers_work(m, problem: Problem, grid: TimeGrid, jobs: JobVariables
     enters each place it works at other than its start location at least once, by a leg no
     shorter than the least from any other place (a robot that may start anywhere enters its
     first place for free). With running jobs, where a robot already is at a job's place,
-    only the work counts."""
+    only the work counts.
+
+    Returns (robot, place) -> the literal "the robot works at the place", for hints."""
+    visits = {}
     fastest = {}
     for job in problem.jobs:
         for index, plan in enumerate(job.plans):
@@ -122,7 +125,7 @@ def makespan_covers_work(m, problem: Problem, grid: TimeGrid, jobs: JobVariables
                 leg = min((grid.ticks(legs[r, a, place]) for a in sources if a != place),
                           default=0)
                 if leg > 0:
-                    visit = m.new_bool_var(f'visits_{place}_{r}')
+                    visit = visits[r, place] = m.new_bool_var(f'visits_{place}_{r}')
                     m.add_max_equality(visit, [jobs.on_job[j, r] for j in mine
                                                if problem.job(j).location == place])
                     entries.append((visit, leg))
@@ -130,6 +133,7 @@ def makespan_covers_work(m, problem: Problem, grid: TimeGrid, jobs: JobVariables
         if robot.start_location is None and entries:
             travel -= max(leg for _, leg in entries)
         m.add(work + travel + grid.ticks(robot.release_time) <= makespan)
+    return visits
 
 
 class PanelVariables:

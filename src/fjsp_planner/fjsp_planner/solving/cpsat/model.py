@@ -52,7 +52,8 @@ class CpsatModel:
         constraints.routes(m, p, grid, self.jobs, self.routes, self.legs, deadline, clock)
         constraints.holding(m, p, self.jobs, self.routes)
         self.makespan = objective.makespan(m, self.jobs, self.horizon)
-        constraints.makespan_covers_work(m, p, grid, self.jobs, self.makespan, self.legs)
+        self.places_visited = constraints.makespan_covers_work(m, p, grid, self.jobs,
+                                                               self.makespan, self.legs)
         self.panels = constraints.panels(m, p, grid, self.jobs, self.makespan,
                                          incumbent if grid.exact else None)
         check(deadline, clock)
@@ -117,6 +118,10 @@ class CpsatModel:
             successor = dict(zip(route, route[1:], strict=False))
             for j in mine:
                 m.add_hint(v.on_job[j, r], int(j in route))
+            places = {p.job(j).location for j in route}
+            for (owner, place), visit in self.places_visited.items():
+                if owner == r:
+                    m.add_hint(visit, int(place in places))
             if r in self.routes.used:
                 for j in mine:
                     m.add_hint(self.routes.first[j, r], int(bool(route) and route[0] == j))
