@@ -79,7 +79,10 @@ def draw_mission(timeline: dict, header: dict, path: Path) -> Drawn:
                         bottom=below / height)
 
     def clip(value):
-        return end if value is None else max(value, 0.0)
+        """A time where the chart can draw it: an open end is the chart's end, and a time
+        off the axes is drawn at the nearest edge (a bar of hostile length rendered whole
+        takes the renderer for ever)."""
+        return end if value is None else min(max(value, 0.0), end * 1.02)
 
     for span in timeline['health']:
         if span['robot'] in rows:
@@ -101,7 +104,7 @@ def draw_mission(timeline: dict, header: dict, path: Path) -> Drawn:
             if t['arrival'] > t['travel_start']:
                 ax.plot([clip(t['travel_start']), clip(t['arrival'])], [y, y], color='grey',
                         lw=0.8)
-            ax.barh(y, t['end'] - t['start'], left=t['start'], height=0.12,
+            ax.barh(y, clip(t['end']) - clip(t['start']), left=clip(t['start']), height=0.12,
                     color=colour[t['job']] if latest else 'none', alpha=0.45 if latest else 1,
                     edgecolor=colour[t['job']] if latest else 'dimgrey',
                     linestyle='-' if latest else '--', lw=0.8)
@@ -109,12 +112,12 @@ def draw_mission(timeline: dict, header: dict, path: Path) -> Drawn:
         if w['robot'] not in rows:
             continue
         y = rows[w['robot']] + WORK
-        stop = clip(now_units if w['open'] else w['end'])
+        start, stop = clip(w['start']), clip(now_units if w['open'] else w['end'])
         style = OUTCOME_STYLE.get(w['outcome'], OUTCOME_STYLE['done'])
-        ax.barh(y, max(stop - w['start'], 0.05), left=w['start'], height=0.3,
-                color=colour[w['job']], **style)
+        ax.barh(y, max(stop - start, 0.05), left=start, height=0.3, color=colour[w['job']],
+                **style)
         if 0 <= (w['start'] + stop) / 2 <= end:  # a text far off the axes cannot be placed
-            labels.add(w['job'] + (f"#{w['attempt']}" if w['attempt'] > 1 else ''), w['start'],
+            labels.add(w['job'] + (f"#{w['attempt']}" if w['attempt'] > 1 else ''), start,
                        stop, y, color='black' if w['outcome'] != 'voided' else 'dimgrey')
     for a in timeline['activities']:
         style = ACTIVITY_STYLE.get(a['mode'])
