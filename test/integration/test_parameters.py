@@ -77,7 +77,7 @@ def test_an_out_of_range_set_is_refused_with_a_reason(fleet):
 
 
 def test_a_read_only_set_is_refused_with_a_reason(fleet):
-    result = set_one(fleet, 'agent_MARC1', 'tick_period', 0.05)
+    result = set_one(fleet, 'agent_MARC1', 'tick_period', 0.02)
     assert not result.successful
     assert 'Trying to set a read-only parameter: tick_period' in result.reason, result.reason
-    assert get(fleet, 'agent_MARC1', 'tick_period') == [0.02]
+    assert get(fleet, 'agent_MARC1', 'tick_period') == [0.01]

@@ -82,7 +82,7 @@ PARAMETERS = table(
     ROBOT_TYPE,
     ParameterSpec('time_scale', 0.0, "wall seconds per schedule unit; 0: the plan's", low=0.0,
                   high=1000.0),
-    ParameterSpec('tick_period', 0.02, 'seconds between steps of the execution',
+    ParameterSpec('tick_period', 0.01, 'seconds between steps of the simulated execution',
                   low=0.001, high=1.0),
     ParameterSpec('heartbeat_period', HEARTBEAT_PERIOD,
                   'seconds between robot states published as heartbeat', low=0.01, high=10.0),
