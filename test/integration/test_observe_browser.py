@@ -57,14 +57,12 @@ def test_live_page_follows_a_mission_through_a_failure(fjsp_fleet, tmp_path):
     port = free_port()
     fleet = fjsp_fleet(PAPER, time_scale=SLOW)
     fleet.start_monitor(out_dir=tmp_path, web_port=port)
+    fleet.start_planner()
+    for robot in ROBOTS:
+        fleet.start_agent(robot)
     assert wait_listening(port, 30), f'the monitor did not serve its page on port {port}'
     with headless_browser() as page:
-        # Open before the fleet starts: a browser slow to start on a loaded machine would
-        # otherwise find the mission over.
         page.get(f'http://127.0.0.1:{port}/')
-        fleet.start_planner()
-        for robot in ROBOTS:
-            fleet.start_agent(robot)
         wait_page(page, lambda p: text(p, '#state') == 'executing', 60, 'the mission executing')
         assert attributes(page, '#connection', 'data-state') == ['live']
         assert text(page, '#revision') == '1'
@@ -108,9 +106,9 @@ def test_the_map_shows_the_robots_moving_and_the_page_draws_on_first_load(fjsp_f
     robots = {r.name for r in fleet.problem.robots}
     fleet.start_monitor(out_dir=tmp_path, web_port=port)
     assert wait_listening(port, 30), f'the monitor did not serve its page on port {port}'
+    fleet.start()
     with headless_browser() as page:
         page.get(f'http://127.0.0.1:{port}/')
-        fleet.start()
         wait_page(page, lambda p: set(robot_marks(p)) == robots, 60, 'every robot on the map')
         assert set(attributes(page, '#map circle.place', 'data-place')) == {
             'depot', 'gate', 'mount', 'mast_head', 'pad'}
