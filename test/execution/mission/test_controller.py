@@ -134,18 +134,14 @@ class Fleet:
             if not isinstance(effect, Solve) or (effect.kind == SolveKind.IMPROVE
                                                  and not improve_too):
                 continue
-            try:
-                if effect.kind == SolveKind.PLAN:
-                    outcome = solve(effect.problem, time_limit=effect.time_limit)
-                elif effect.kind == SolveKind.REPAIR:
-                    outcome = repair(effect.problem, effect.previous, effect.state,
-                                     time_limit=effect.time_limit)
-                else:
-                    outcome = improve(effect.published, time_limit=effect.time_limit,
-                                      frozen_until=effect.frozen_until,
-                                      started=effect.started)
-            except ValueError as error:  # the node hands the controller what a solve raised
-                outcome = error
+            if effect.kind == SolveKind.PLAN:
+                outcome = solve(effect.problem, time_limit=effect.time_limit)
+            elif effect.kind == SolveKind.REPAIR:
+                outcome = repair(effect.problem, effect.previous, effect.state,
+                                 time_limit=effect.time_limit)
+            else:
+                outcome = improve(effect.published, time_limit=effect.time_limit,
+                                  frozen_until=effect.frozen_until, started=effect.started)
             out += self.take(self.controller.solved(effect.token, outcome, self.wall))
         return out
 
@@ -1197,123 +1193,6 @@ def test_a_resumed_mission_whose_histories_break_the_timeline_fails(problem):
     history_of(restarted, plan, time=0.0)
     assert restarted.state() == MissionState.FAILED
     assert any('executed timeline' in r for r in restarted.status().blocked)
-
-
-def test_a_silent_robots_late_completion_does_not_block_the_robots_that_moved_on(problem):
-    """A robot whose reports stop reaching the planner (its writer flooded) finishes its
-    operation on Aa; Aa's other robots, which heard it, move on to their next job. Their
-    arrival there tells the planner Aa is complete (a robot leaves a job only once every
-    robot on it is done), so the re-plan without the silent robot starts from a consistent
-    state instead of having the movers on two jobs at once; its late report changes
-    nothing, and every job is done exactly once."""
-    fleet = executing(problem)
-    plan = fleet.controller.mission.schedule
-    aa = plan.jobs['Aa']
-    silent = next(r for r in aa.robots if r not in plan.jobs['Ja'].robots)
-    movers = [r for r in aa.robots if r != silent]
-    following = {r: plan.sequences[r][plan.sequences[r].index('Aa') + 1] for r in movers}
-    assert set(following.values()) == {'Jb'}  # the paper's optimum: the holders go on to Jb
-    jb = plan.jobs['Jb']
-    fleet.tick(advance=float(jb.start) + 0.5)
-    fleet.execute(until=aa.start)
-    for robot in aa.robots:
-        fleet.event(EventKind.STARTED, robot, 'Aa', float(aa.start))
-    for robot in movers:
-        fleet.event(EventKind.OPERATION_DONE, robot, 'Aa',
-                    float(aa.start + problem.duration(robot, aa.robots[robot])))
-    silent_end = float(aa.start + problem.duration(silent, aa.robots[silent]))
-    for robot in movers:
-        for kind in (EventKind.ARRIVED, EventKind.STARTED):
-            fleet.event(kind, robot, 'Jb', float(jb.start))
-    # The silent robot is declared offline: the re-plan goes on without it.
-    others = tuple(r for r in ROBOTS if r != silent)
-    fleet.tick(advance=1.5, robots=others)
-    fleet.run_solves()
-    assert fleet.state() == MissionState.EXECUTING, fleet.status().blocked
-    assert [e.job for e in kinds(fleet.effects, JobDone)].count('Aa') == 1
-    assert fleet.controller.mission.tracker.revision == 2
-    # It is back, and its report of Aa arrives at last.
-    fleet.tick(advance=1.5)
-    fleet.event(EventKind.OPERATION_DONE, silent, 'Aa', silent_end, revision=1)
-    fleet.run_solves()
-    assert fleet.state() == MissionState.EXECUTING, fleet.status().blocked
-    fleet.execute()
-    assert fleet.state() == MissionState.COMPLETE, fleet.status().blocked
-    done = [e.job for e in kinds(fleet.effects, JobDone)]
-    assert sorted(done) == sorted(j.name for j in problem.jobs)
-    assert fleet.controller.mission.tracker.violations() == []
-
-
-@pytest.mark.parametrize('late', ['none', 'before back', 'after back', 'after replan'])
-def test_a_robot_offline_mid_job_that_kept_working_does_not_block_the_mission(problem, late):
-    """Assembler goes silent on Ja while in fact it works on; the planner re-plans without
-    it, which redoes Ja. Its reports of the old attempt (Ja finished, Aa begun) arrive at
-    any point: while it is offline, once it is back, or after the re-plan that takes it
-    back. They no longer count, and the mission completes with every job done once."""
-    fleet = executing(problem)
-    plan = fleet.controller.mission.schedule
-    ja, aa = plan.jobs['Ja'], plan.jobs['Aa']
-    assert 'Assembler' in ja.robots and 'Assembler' in aa.robots
-    fleet.tick(advance=float(ja.start) + 0.5)
-    fleet.execute(until=ja.start)
-    for robot in ja.robots:
-        fleet.event(EventKind.STARTED, robot, 'Ja', float(ja.start))
-    old = [(EventKind.OPERATION_DONE, 'Ja',
-            float(ja.start + problem.duration('Assembler', ja.robots['Assembler']))),
-           (EventKind.ARRIVED, 'Aa', float(aa.start)), (EventKind.STARTED, 'Aa', float(aa.start))]
-
-    def old_reports():
-        for kind, job, time in old:
-            fleet.event(kind, 'Assembler', job, time, revision=1)
-
-    others = ROBOTS[1:]
-    fleet.tick(advance=1.5, robots=others)
-    fleet.run_solves()
-    assert fleet.controller.mission.tracker.revision == 2
-    if late == 'before back':
-        old_reports()
-    fleet.tick(advance=0.5)
-    if late == 'after back':
-        old_reports()
-    fleet.tick(advance=1.0)
-    fleet.run_solves()
-    if late == 'after replan':
-        old_reports()
-    assert fleet.controller.mission.tracker.revision == 3
-    assert fleet.state() == MissionState.EXECUTING, fleet.status().blocked
-    fleet.execute()
-    assert fleet.state() == MissionState.COMPLETE, fleet.status().blocked
-    done = [e.job for e in kinds(fleet.effects, JobDone)]
-    assert sorted(done) == sorted(j.name for j in problem.jobs)
-
-
-def test_contradicting_reports_block_the_mission_until_the_missing_ones_arrive(problem):
-    """Assembler's start of Aa arrives before its own end of Ja (a history resent out of
-    order): it looks on two jobs at once. The mission is blocked saying so, and re-planned
-    once the missing reports make the state consistent, without any robot changing."""
-    fleet = executing(problem)
-    plan = fleet.controller.mission.schedule
-    ja, aa = plan.jobs['Ja'], plan.jobs['Aa']
-    fleet.tick(advance=float(aa.start) + 0.5)
-    fleet.execute(until=ja.start)
-    for robot in ja.robots:
-        fleet.event(EventKind.STARTED, robot, 'Ja', float(ja.start))
-    fleet.event(EventKind.STARTED, 'Assembler', 'Aa', float(aa.start))
-    fleet.failures['LSMS'] += 1
-    fleet.report('LSMS', RobotMode.FAILED)
-    fleet.tick()
-    fleet.run_solves()
-    assert fleet.state() == MissionState.BLOCKED
-    (reason,) = fleet.status().blocked
-    assert reason.startswith("the robots' reports so far contradict each other")
-    assert "robot 'Assembler' runs both" in reason
-    for robot, operation in ja.robots.items():
-        fleet.event(EventKind.OPERATION_DONE, robot, 'Ja',
-                    float(ja.start + problem.duration(robot, operation)))
-    fleet.tick()
-    fleet.run_solves()
-    assert fleet.state() == MissionState.EXECUTING, fleet.status().blocked
-    assert fleet.controller.mission.tracker.revision == 2
 
 
 def test_an_execution_state_the_tracker_cannot_tell_blocks_the_mission(problem):

@@ -10,10 +10,6 @@ never raised: a message must not crash the planner.
 
 A plan revision either continues a job (it was under way) or starts it afresh: reports about
 a job made under a revision older than the one that last started it no longer count.
-
-A job is complete when every robot on it reported its operation done, or as soon as one of
-them, having reported its own, arrives at its next job: agents leave a job only once it is
-complete, so a robot is never counted on two jobs at once for want of a late report.
 """
 
 import dataclasses
@@ -67,8 +63,6 @@ class JobRecord:
     """A robot on it failed while working: it waits for a new revision to be redone."""
     done_as: JobAssignment | None = None
     """The plan and robots it was completed with."""
-    left: bool = False
-    """Completed by a robot's arrival at its next job, before every report of it came."""
 
     @property
     def start(self) -> float | None:
@@ -196,11 +190,6 @@ class MissionTracker:
                 return Verdict()
             self.jobs[job] = JobRecord(job, since_revision=record.since_revision, aborted=True)
             return Verdict()
-        if record.end is not None and record.left and robot not in facts[kind]:
-            # A report of a job its robots had left, late behind their arrivals elsewhere:
-            # kept, though the job is complete, and not counted as ignored.
-            facts[kind][robot] = time
-            return Verdict()
         if robot in facts[kind] or record.end is not None:
             self.ignored[Ignored.DUPLICATE] += 1
             return Verdict(Ignored.DUPLICATE, f"'{robot}' already reported {kind} for job "
@@ -209,51 +198,12 @@ class MissionTracker:
         if kind == EventKind.OPERATION_DONE:
             robots = self.plan.jobs[job].robots
             if all(r in record.operation_done for r in robots):
-                self._complete(job, max(record.operation_done[r] for r in robots))
+                record.end = max(record.operation_done[r] for r in robots)
+                planned = self.plan.jobs[job]
+                record.done_as = JobAssignment(job, planned.plan, Fraction(record.start),
+                                               Fraction(record.end), dict(robots))
                 return Verdict(job_done=(job, record.end))
-            return Verdict()
-        left = self._left_behind(robot, job)
-        if left is not None:
-            return Verdict(job_done=left)
         return Verdict()
-
-    def _complete(self, job: str, end: float) -> None:
-        record, planned = self.jobs[job], self.plan.jobs[job]
-        record.end = end
-        record.done_as = JobAssignment(job, planned.plan, Fraction(record.start),
-                                       Fraction(end), dict(planned.robots))
-
-    def _left_behind(self, robot: str, job: str) -> tuple[str, float] | None:
-        """The job `robot` was on before `job` in its sequence, if it still runs here: it is
-        complete, and its end is returned.
-
-        An agent leaves a job only once every robot on it reported its operation done (or
-        the planner declared it done), and goes on to the next job of its sequence. So its
-        arrival at that next job proves the job before complete, even when the report of
-        one of its robots has not reached the planner: that robot's writer may be flooded
-        or cut off, its robot declared offline, and the report arrive much later or never.
-        Waiting for it would leave the robots that moved on counted on two jobs at once,
-        a state no re-plan can start from. The job ended at the latest report of it that did
-        arrive, which is no later than the true end: every robot left it after the true end,
-        and every job that waited for it began after the true end or after the end declared
-        here, so the timeline stays valid whatever the missing report says (an end read
-        back from an arrival, less the leg, could lie after another robot's departure).
-        """
-        sequence = self.plan.sequences.get(robot, ())
-        if job not in sequence:
-            return None
-        position = sequence.index(job)
-        if position == 0:
-            return None
-        before = sequence[position - 1]
-        record = self.jobs[before]
-        if record.end is not None or not record.started or record.aborted \
-                or robot not in record.operation_done:
-            return None
-        end = max(record.operation_done.values())
-        self._complete(before, end)
-        record.left = True
-        return before, end
 
     def _check_event(self, event_id, kind, robot, job, revision, time) -> Verdict | None:
         if not isinstance(event_id, str):

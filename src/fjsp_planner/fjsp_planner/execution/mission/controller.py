@@ -43,13 +43,7 @@ from fjsp_planner.execution.mission.reports import EventReport, RobotReport
 from fjsp_planner.execution.mission.resume import restarted_while_down, restore, started_where
 from fjsp_planner.execution.mission.settings import Settings
 from fjsp_planner.execution.mission.states import INITIAL, check_transition
-from fjsp_planner.execution.replan import (
-    ExecutionState,
-    Replan,
-    RobotSituation,
-    StateError,
-    residual_problem,
-)
+from fjsp_planner.execution.replan import ExecutionState, Replan, RobotSituation, residual_problem
 from fjsp_planner.execution.tracking import Ignored, MissionTracker
 from fjsp_planner.model.problem import Problem
 from fjsp_planner.model.schedule import Result, Schedule, Status
@@ -673,10 +667,6 @@ class MissionController:
             # its crew's previous job does not look finished yet. Try again once more is
             # known, rather than stay blocked until the fleet changes.
             mission.pending, mission.retry = solving.reasons, (mission.reports, wall)
-            if isinstance(outcome, StateError):
-                return self._block(mission, wall, (
-                    "the robots' reports so far contradict each other; re-planning again as "
-                    'more arrive: ' + '; '.join(outcome.problems),))
             return self._block(mission, wall, (f're-planning failed: {outcome}',))
         replanned: Replan = outcome
         residual = replanned.residual
