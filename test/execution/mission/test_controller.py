@@ -438,6 +438,17 @@ def test_a_fleet_that_falls_silent_together_is_offline_after_three_timeouts(prob
     assert fleet.state() == MissionState.COMPLETE
 
 
+def test_a_fleet_heard_again_after_falling_silent_is_planned_back_in(problem):
+    fleet = executing(problem)
+    fleet.tick(advance=3.2, robots=())
+    fleet.run_solves()
+    assert fleet.state() == MissionState.BLOCKED
+    fleet.tick(advance=1.2)
+    fleet.run_solves()
+    assert fleet.state() == MissionState.EXECUTING, fleet.status().blocked
+    assert fleet.controller.mission.tracker.revision == 2
+
+
 def test_executed_mission_completes(problem):
     fleet = executing(problem)
     fleet.execute()
