@@ -606,3 +606,37 @@ def test_failing_while_waiting_at_a_job_withdraws_from_it():
     b.aborted('J1', 1)
     b.job_done('J0', 4, 1)
     assert b.step(5) == [] and b.mode == RobotMode.WAITING
+
+
+def test_a_robot_recovered_at_a_job_it_finished_its_part_of_stays_until_the_job_completes():
+    """Found by the soak: T1 finished its operation of PetalA, failed while T2 still worked on
+    it, and recovered; the re-plan sent it on to PetalB and it left at once. A robot is on a
+    job until the job completes (the planner plans it free at the job's end, and the record
+    of the mission has it there until then): it leaves when the job's last robot is done."""
+    r = RobotExecution('A')
+    plan(r, 1, [task('J1', 0, 1, end=5, co=['B']), task('J2', 7, 1, leg=2)],
+         {'J1': {'A', 'B'}, 'J2': {'A'}})
+    r.arrived('B', 'J1', 0.0, 1)
+    assert kinds(r.step(1.5)) == [(ARRIVED, 'J1', 0), (STARTED, 'J1', 0), (DONE, 'J1', 1)]
+    assert r.mode == RobotMode.WAITING
+    assert r.fail(2).accepted
+    r.recover(3)
+    plan(r, 2, [task('J2', 7, 1, leg=2)], {'J1': {'A', 'B'}, 'J2': {'A'}}, now=3,
+         continued=['J1'])
+    assert r.step(4.5) == []
+    assert (r.mode, r.current_job, r.location) == (RobotMode.WAITING, 'J1', 'J1')
+    r.operation_done('B', 'J1', 5.0, 1)
+    assert kinds(r.step(10)) == [(ARRIVED, 'J2', 7), (STARTED, 'J2', 7), (DONE, 'J2', 8)]
+
+
+def test_a_robot_recovered_at_a_job_restarted_without_it_leaves_at_once():
+    """Where the re-plan restarts that job without it, nothing holds it there."""
+    r = RobotExecution('A')
+    plan(r, 1, [task('J1', 0, 1, end=5, co=['B']), task('J2', 7, 1, leg=2)],
+         {'J1': {'A', 'B'}, 'J2': {'A'}})
+    r.arrived('B', 'J1', 0.0, 1)
+    r.step(1.5)
+    r.fail(2)
+    r.recover(3)
+    plan(r, 2, [task('J2', 5, 1, leg=2)], {'J1': {'B'}, 'J2': {'A'}}, now=3)
+    assert kinds(r.step(10)) == [(ARRIVED, 'J2', 5), (STARTED, 'J2', 5), (DONE, 'J2', 6)]

@@ -138,6 +138,10 @@ class RobotExecution:
         it stands between `location` and `destination`."""
         self._holding = ''
         """The done jig job whose part the robot holds into its next job ('' if none)."""
+        self._finishing = ''
+        """The job whose operation it has done while others still work on it ('' if none):
+        it stays there until the job completes, even when a fault or a new plan takes the job
+        off its sequence, as the planner plans it free only at the job's end."""
         self._factor = 1.0
         """Duration factor of the next operation the robot begins (delay faults)."""
         self._work_factor = 1.0
@@ -161,7 +165,9 @@ class RobotExecution:
     @property
     def current_job(self) -> str:
         task = self.task
-        return task.job if task else ''
+        if task is not None:
+            return task.job
+        return self._finishing if self._phase == _Phase.NEXT else ''
 
     @property
     def mode(self) -> RobotMode:
@@ -175,6 +181,8 @@ class RobotExecution:
             return RobotMode.HOLDING if self.task.held_into_next else RobotMode.WAITING
         if self._phase == _Phase.WAIT:
             return RobotMode.HOLDING if self._holding else RobotMode.WAITING
+        if self._phase == _Phase.NEXT and self._finishing:
+            return RobotMode.WAITING
         return RobotMode.IDLE
 
     @property
@@ -457,7 +465,7 @@ class RobotExecution:
         if self._phase == _Phase.WORK and self._begun:
             self.driver.stop(now)
             self._begun = False
-        self.tasks, self._index, self._holding = (), 0, ''
+        self.tasks, self._index, self._holding, self._finishing = (), 0, '', ''
         if self._on_a_leg:
             self._phase = _Phase.TRANSIT
         elif self._phase != _Phase.FAILED:
@@ -533,7 +541,7 @@ class RobotExecution:
             end = max(ending.end, self._phase_start)
             self._record(self._operation_done, (self.robot, task.job), task.job, end,
                          self.revision)
-            self._phase = _Phase.FINISH
+            self._phase, self._finishing = _Phase.FINISH, task.job
             events.append(Event(EventKind.OPERATION_DONE, task.job, end,
                                 self._attempts[task.job]))
             return True
@@ -541,7 +549,7 @@ class RobotExecution:
             end = self._job_end(self.task.job)
             if end is None or now < end:
                 return False
-            self._free_at = end
+            self._free_at, self._finishing = end, ''
             self._holding = self.task.job if self.task.held_into_next else ''
             self._index += 1
             self._phase = _Phase.NEXT
@@ -591,6 +599,8 @@ class RobotExecution:
         if self._index >= len(self.tasks):
             self._phase, self._holding = _Phase.DONE, ''
             return False
+        if not self._left_finished_job():
+            return False
         task = self.tasks[self._index]
         self._attempts[task.job] = self._attempts.get(task.job, 0) + 1
         departure = max(self._free_at, self._not_before)
@@ -619,6 +629,24 @@ class RobotExecution:
         self._leg = Leg(task.job, self.location, task.location, leg) if leg > 0 else None
         self._begun = False
         self.destination = task.location
+        return True
+
+    def _left_finished_job(self) -> bool:
+        """Whether the robot is free of the job it did its part of (advancing `_free_at` to
+        that job's end): once the job completes, or when a restart voided its part. A job the
+        plan leaves out was complete when planned, at its last reported operation's end."""
+        job = self._finishing
+        if not job:
+            return True
+        if (self.robot, job) in self._operation_done:
+            end = self._job_end(job)
+            if end is None and job not in self._job_robots:
+                end = max(fact.time for (_, done), fact in self._operation_done.items()
+                          if done == job)
+            if end is None:
+                return False
+            self._free_at = max(self._free_at, end)
+        self._finishing = ''
         return True
 
     def _finished(self, job: str) -> bool:
