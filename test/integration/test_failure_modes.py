@@ -117,7 +117,9 @@ def test_jobs_done_while_replanning_are_not_done_again(fjsp_fleet):
 def test_an_agent_that_never_gets_the_plan_is_planned_without_until_it_does(fjsp_fleet):
     """MARC2's agent reports, but its plan subscription hears nothing (remapped away, as a
     subscription that never matched the plan's writer): the mission must not wait on it."""
-    fleet = fjsp_fleet(PAPER, time_scale=0.15, planner={'plan_uptake_timeout': 3.0})
+    # Slow enough (about 20 s of mission left) that a loaded machine restarts MARC2's agent
+    # before the three others finish the mission without it.
+    fleet = fjsp_fleet(PAPER, time_scale=0.4, planner={'plan_uptake_timeout': 3.0})
     for robot in ROBOTS[:3]:
         fleet.start_agent(robot)
     fleet.start_node(agent_node_name('MARC2'), 'robot_agents', 'robot_agent',
