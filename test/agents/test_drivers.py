@@ -23,6 +23,8 @@ class ScriptedDriver:
         self._start = math.nan
         self._ending: Ending | None = None
 
+    ends_when_expected = False
+
     def begin(self, work, start):
         self.begun.append((work, start))
         self._start, self._ending, self.share = start, None, 0.0
@@ -82,6 +84,17 @@ def test_legs_and_operations_last_what_the_robot_took_from_their_logical_start()
     assert kinds(r.step(4)) == [(DONE, 'J1', 3.5)]
     assert driver.begun[2][0] == Leg('J2', 's', 'J2', 4.0)
     assert r.mode == RobotMode.TRAVELLING and r.busy_until == pytest.approx(103.5)
+
+
+def test_a_robot_whose_driver_alone_knows_when_its_work_ends_is_polled():
+    r, driver = robot([task('J1', 2, 3, leg=2, location='s')])
+    assert r.step(0.0) == [] and r.due() is None          # on its leg
+    driver.finish(2.5)
+    r.step(3)
+    assert r.due() is None                                # at work
+    driver.finish(1.0)
+    r.step(4)
+    assert r.finished and r.due() == math.inf
 
 
 def test_a_robot_failure_during_an_operation_aborts_it_and_fails_the_robot():

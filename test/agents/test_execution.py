@@ -640,3 +640,27 @@ def test_a_robot_recovered_at_a_job_restarted_without_it_leaves_at_once():
     r.recover(3)
     plan(r, 2, [task('J2', 5, 1, leg=2)], {'J1': {'B'}, 'J2': {'A'}}, now=3)
     assert kinds(r.step(10)) == [(ARRIVED, 'J2', 5), (STARTED, 'J2', 5), (DONE, 'J2', 6)]
+
+
+def test_the_robot_is_due_when_its_next_move_is_and_not_before():
+    """What the agent sleeps until: a departure, the end of a leg or operation, a start or a
+    job's end the reports fix; nothing while it waits on a report."""
+    r = RobotExecution('A')
+    plan(r, 1, [task('J0', 3, 1, leg=1, location='s'), task('J1', 6, 1, end=8, co=['B'], leg=2)],
+         {'J0': {'A'}, 'J1': {'A', 'B'}})
+    r.step(0)
+    assert r.due() == 2                                   # it leaves at 2
+    r.step(2)
+    assert r.due() == pytest.approx(3)                    # and arrives at 3
+    r.step(3.5)
+    assert r.mode == RobotMode.WORKING and r.due() == pytest.approx(4)
+    r.step(7)
+    assert r.mode == RobotMode.WAITING and r.due() == math.inf   # B has not arrived
+    r.arrived('B', 'J1', 6.5, 1)
+    assert r.due() == 6.5
+    r.step(7.6)
+    assert r.mode == RobotMode.WAITING and r.due() == math.inf   # B's operation goes on
+    r.operation_done('B', 'J1', 8.0, 1)
+    assert r.due() == 8
+    r.step(8)
+    assert r.finished and r.due() == math.inf

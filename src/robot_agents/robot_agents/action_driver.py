@@ -76,6 +76,8 @@ class _Goal:
 class ActionDriver:
     """A `Driver` whose robot serves its legs and operations as ROS 2 actions."""
 
+    ends_when_expected = False
+
     def __init__(self, node: Node, robot: str, travel_action: str, operation_action: str,
                  server_timeout: float, time_scale: Callable[[], float],
                  schedule_time: Callable[[], float]):

@@ -13,6 +13,7 @@ mission (a later `mission_start`) starts afresh from where the robot is. Faults 
 through `<robot_name>/inject_fault` (`fjsp_planner.faults`).
 """
 
+import math
 import sys
 from collections import deque
 from dataclasses import replace
@@ -70,6 +71,11 @@ from robot_agents.execution import FaultResult, RobotExecution, Task
 from robot_agents.reports import ReportLog
 
 ANSWERS_KEPT = 1024
+IDLE_TICK = 0.25
+"""Seconds at most between steps while nothing is due: a safety net, as every plan, report
+and fault steps the robot when it comes."""
+DUE_MARGIN = 0.0005
+"""Seconds a step is set after the instant it is due at, so that the clock has reached it."""
 NAME_LOOKUP_NODE = 'robot_agent'
 """The short-lived node that reads `robot_name` before the agent's own node can be named."""
 
@@ -82,7 +88,8 @@ PARAMETERS = table(
     ROBOT_TYPE,
     ParameterSpec('time_scale', 0.0, "wall seconds per schedule unit; 0: the plan's", low=0.0,
                   high=1000.0),
-    ParameterSpec('tick_period', 0.01, 'seconds between steps of the simulated execution',
+    ParameterSpec('tick_period', 0.01, 'seconds between polls of a robot driven by actions; '
+                  'the mock robot steps when its next leg, operation or job is due',
                   low=0.001, high=1.0),
     ParameterSpec('heartbeat_period', HEARTBEAT_PERIOD,
                   'seconds between robot states published as heartbeat', low=0.01, high=10.0),
@@ -160,7 +167,8 @@ class RobotAgent(Node):
             raise ParameterError(f"parameter 'robot_name' must be usable in a ROS name "
                                  f'(letters, digits, underscores), got {self.robot!r}') from None
         self.diagnostics_pub = publisher(self, DIAGNOSTICS)
-        self.create_timer(value['tick_period'], self.tick)
+        self.tick_period = value['tick_period']
+        self.tick_timer = self.create_timer(self.tick_period, self.tick)
         self.create_timer(value['heartbeat_period'], self.publish_state)
         self.create_timer(value['diagnostics_period'], self.publish_diagnostics)
         reports_dir = value['reports_dir']
@@ -293,6 +301,7 @@ class RobotAgent(Node):
         self.get_logger().warning(f"mission '{shorten(msg.mission_id, 80)}' cancelled: "
                                   'tasks dropped')
         self.publish_state()
+        self.tick()
 
     # --- what the others report --------------------------------------------------------
 
@@ -348,6 +357,7 @@ class RobotAgent(Node):
             result = FaultResult(False, f"robot '{self.robot}': unknown fault "
                                         f'{request.fault} (FAIL=0, RECOVER=1, DELAY=2)')
         self.publish_events(result.events)
+        self.tick()     # a delay moves the end of the operation under way
         if result.accepted:
             if request.fault == InjectFault.Request.FAULT_FAIL:
                 self.failures += 1
@@ -366,11 +376,30 @@ class RobotAgent(Node):
 
     def tick(self) -> None:
         now = self.now_units()
-        if now is None or now < 0:
-            return
-        self.publish_events(self.execution.step(now))
-        if self.state_key() != self.last_state:
-            self.publish_state()
+        if now is not None and now >= 0:
+            self.publish_events(self.execution.step(now))
+            if self.state_key() != self.last_state:
+                self.publish_state()
+        self.schedule_tick(now)
+
+    def schedule_tick(self, now: float | None) -> None:
+        """Step next when the execution is due, or at the latest after `IDLE_TICK` (a plan,
+        report or fault steps it at once); poll every `tick_period` while only the driver
+        knows when its work ends."""
+        if now is None:
+            wait = IDLE_TICK    # no mission yet
+        else:
+            due = 0.0 if now < 0 else self.execution.due()
+            if due is None or math.isnan(due):
+                wait = self.tick_period
+            else:
+                # Slightly past the instant, so that the step finds it due.
+                wait = (due - now) * self.clock.time_scale + DUE_MARGIN
+                wait = min(max(wait, self.tick_period), IDLE_TICK)
+        period = round(wait * 1e9)
+        if period != self.tick_timer.timer_period_ns:
+            self.tick_timer.timer_period_ns = period
+        self.tick_timer.reset()
 
     def state_key(self):
         execution = self.execution

@@ -78,6 +78,10 @@ class Driver(Protocol):
     instant the plan's semantics give it (a leg's departure, a job's start), never after the
     call."""
 
+    ends_when_expected: bool
+    """True when every leg and operation ends at `expected_end()` (the agent sleeps until
+    then); False when only `ending` can tell (the agent polls it)."""
+
     def begin(self, work: Leg | Operation, start: float) -> None:
         """Set off on a leg, or begin an operation."""
 
@@ -104,6 +108,8 @@ class Driver(Protocol):
 class MockDriver:
     """A robot that takes exactly the planned time for every leg and operation, and never
     fails of itself (faults are injected into the agent)."""
+
+    ends_when_expected = True
 
     def __init__(self):
         self._start = math.nan

@@ -194,6 +194,24 @@ class RobotExecution:
             return self._phase_start + (self._leg.duration if self._leg else 0.0)
         return math.nan
 
+    def due(self) -> float | None:
+        """The schedule time at which `step` next has something to do by itself: a departure,
+        the end of the leg or operation under way, a job's start or end as the reported facts
+        fix it; `math.inf` when only a new plan, fact or fault can move the robot; None while
+        only its driver can tell when the work under way ends (`step` must be polled)."""
+        phase = self._phase
+        if phase in (_Phase.TRAVEL, _Phase.TRANSIT, _Phase.WORK):
+            if not self._begun:
+                return self._phase_start
+            return self.driver.expected_end() if self.driver.ends_when_expected else None
+        if phase == _Phase.WAIT:
+            when = self._start_time(self.task)
+        elif phase == _Phase.FINISH:
+            when = self._job_end(self.task.job)
+        else:
+            return math.inf
+        return math.inf if when is None else when
+
     def progress(self, now: float) -> float:
         """0..1 of the current leg or operation; of the leg it stopped on, if it stands
         between two places."""
