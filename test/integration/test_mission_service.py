@@ -132,7 +132,8 @@ def test_cancel_and_add_name_the_mission_they_are_for(fjsp_fleet):
     with client_of(fleet) as client:
         with pytest.raises(MissionError, match='no mission runs: the planner waits for one'):
             client.cancel()
-        mission = client.submit(PAPER)
+        # Slow (32 s): it is cancelled long before, however slowly the CLI starts.
+        mission = client.submit(PAPER, time_scale=1.0)
         with pytest.raises(MissionError, match="no mission 'earlier' is running or waits in "
                                                f"the queue \\(running: '{mission.mission_id}'"):
             client.add_jobs(fragment_yaml='jobs: []\n', mission_id='earlier')
