@@ -166,26 +166,32 @@ def _screened(topic: Topic, callback, auth):
     return screen
 
 
-def take_waiting(sub, callback, limit: int = DRAIN) -> None:
+def take_waiting(sub, callback, limit: int = DRAIN) -> int:
     """Hand `callback` the messages waiting in `sub`'s history, up to `limit`, without the
-    executor (a node stopping takes what arrived before it closes)."""
-    for _ in range(limit):
+    executor (a node stopping takes what arrived before it closes); how many it took."""
+    for count in range(limit):
         try:
             with sub.handle:
                 taken = sub.handle.take_message(sub.msg_type, sub.raw)
         except InvalidHandle:
-            return  # destroyed by the callback
+            return count  # destroyed by the callback
         if taken is None:
-            return
+            return count
         callback(taken[0])
+    return limit
 
 
 def catch_up(sub) -> None:
-    """Serve `sub` now with the messages waiting in its history, as the executor would: a
+    """Serve `sub` now with every message waiting in its history, as the executor would: a
     node about to judge by what it heard (a robot silent for too long) first takes what has
     arrived. The executor serves a node's timers before its subscriptions, so a node kept
-    from a core for a while would otherwise judge by what it heard before."""
-    take_waiting(sub, sub.callback, limit=1)  # its callback takes the rest
+    from a core for a while would otherwise judge by what it heard before; and the newest
+    messages come last, behind however many a flood left waiting. It takes at most a full
+    history and a drain more, so that a flood outpacing it cannot hold the node here."""
+    rounds = sub.qos_profile.depth // (DRAIN + 1) + 2
+    for _ in range(rounds):
+        if not take_waiting(sub, sub.callback, limit=1):  # its callback takes up to DRAIN more
+            return
 
 
 def _pair(vocabulary, message, prefix: str) -> tuple[dict, dict]:
