@@ -75,3 +75,22 @@ def test_cpsat_given_the_bound_stops_when_a_schedule_meets_it():
                       [('x1', 'a'), ('x2', 'a'), ('x3', 'a'), ('y', 'b')])
     result = solve_cpsat(problem, 5, 1, lower_bound=fleet_load_bound(problem, 5))
     assert result.status == Status.OPTIMAL and result.makespan == result.lower_bound == 6
+
+
+def test_a_robot_goes_from_one_place_to_the_next():
+    """W starts at a hub 5 from each of three sites, the sites 10 apart: whatever the
+    order, after the first site (5) it goes on to the next two (10 each): with 3 welds of 2,
+    31, the optimum. One least leg into each site counts only 5 per site (from the hub):
+    21."""
+    distances = {}
+    for site in 'xyz':
+        distances['hub', site] = distances[site, 'hub'] = Fraction(5)
+        for other in 'xyz':
+            if other != site:
+                distances[site, other] = Fraction(10)
+    problem = Problem(operation_types={1: 'weld', 2: 'move'},
+                      robot_types={'Welder': {1: Fraction(2), 2: Fraction(1)}},
+                      robots=(Robot('W', 'Welder', start_location='hub'),),
+                      jobs=tuple(Job(site, site, ((1,),)) for site in 'xyz'),
+                      distances=distances, locomote=2)
+    assert fleet_load_bound(problem, 5) == 31 == solve(problem).makespan

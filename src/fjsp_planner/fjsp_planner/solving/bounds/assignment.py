@@ -5,10 +5,11 @@ Every robot is busy for the whole of each job it works on, and it enters each pl
 works at, other than its start location, by a leg no shorter than the least into that place
 from any other (a robot that may start anywhere enters its first place for free). So its
 release time, the durations of its jobs and those legs fit in the makespan, whatever the
-order. CP-SAT chooses every job's staffing (a set of robots, at the least duration that set
-achieves) to minimise the largest such sum; `bounds.fleet` counts the same per robot only
-for the jobs nobody else can do, and the work of a group without its travel. Times are
-floored onto a grid, which only lowers the bound.
+order; so do its release time, its jobs and its shortest way through those places, each
+once, along the least ways of the distance table. CP-SAT chooses every job's staffing (a
+set of robots, at the least duration that set achieves) to minimise the largest such sum;
+`bounds.fleet` counts the same per robot only for the jobs nobody else can do, and the work
+of a group without its travel. Times are floored onto a grid, which only lowers the bound.
 """
 
 import math
@@ -17,7 +18,7 @@ from fractions import Fraction
 from ortools.sat.python import cp_model
 
 from fjsp_planner.model.problem import Problem
-from fjsp_planner.solving.bounds.geometry import least_leg_into
+from fjsp_planner.solving.bounds.geometry import least_leg_into, least_location_travel
 from fjsp_planner.solving.bounds.jobs import fastest_sets
 from fjsp_planner.solving.cpsat.grid import objective_ticks
 
@@ -57,6 +58,10 @@ def fleet_load_bound(problem: Problem, time_limit: float, workers: int = 1,
     horizon = sum(max(ticks(d) for d, _ in found) for found in choices.values())
     horizon += max(ticks(r.release_time) for r in problem.robots) + max(
         map(ticks, entries.values()), default=0) + sum(map(ticks, legs.values()))
+    # Room for the longest route: the longest least way into each place.
+    horizon += len(places) * max(
+        (ticks(least_location_travel(problem, r.name, a, b)) for r in problem.robots
+         for a in places | {r.start_location} - {None} for b in places), default=0)
     m = cp_model.CpModel()
     makespan = m.new_int_var(0, horizon, 'makespan')
     load = {r: [] for r in robots}
@@ -70,12 +75,16 @@ def fleet_load_bound(problem: Problem, time_limit: float, workers: int = 1,
             for r in members:
                 load[r].append(pick * ticks(duration))
                 works.setdefault((r, job.location), []).append(pick)
+    places_of = {}
+    """robot -> the places it may work at, in the order of its `visits` literals."""
     for robot in problem.robots:
         r = robot.name
         visits, firsts, travel = [], [], []
+        places_of[r] = []
         for (who, place), picks in sorted(works.items()):
             if who != r:
                 continue
+            places_of[r].append(place)
             visit = m.new_bool_var(f'visits_{place}_{r}')
             for pick in picks:
                 m.add_implication(pick, visit)
@@ -94,6 +103,8 @@ def fleet_load_bound(problem: Problem, time_limit: float, workers: int = 1,
         for visit in visits:
             m.add(sum(firsts) >= visit)
         m.add(makespan >= sum(load[r]) + sum(travel) + ticks(robot.release_time))
+        route = _route_through(m, problem, robot, ticks, places_of[r], visits)
+        m.add(makespan >= sum(load[r]) + route + ticks(robot.release_time))
     m.minimize(makespan)
     solver = cp_model.CpSolver()
     solver.parameters.max_time_in_seconds = max(0.01, time_limit)
@@ -105,3 +116,32 @@ def fleet_load_bound(problem: Problem, time_limit: float, workers: int = 1,
         return None
     found = Fraction(objective_ticks(solver.best_objective_bound), scale)
     return found if incumbent is None else min(found, incumbent)
+
+
+def _route_through(m, problem: Problem, robot, ticks, places, visits):
+    """The robot's least travel through the places it visits (`visits`, one literal per
+    place), from its start location (from nowhere without one): a circuit over the places
+    and a depot, each leg the least way between two places, the way back to the depot free.
+
+    A robot's route visits its places in some order, maybe more than once; each leg is no
+    shorter than the least way along the distance table, and with least ways a route that
+    skips a place's later visits is no longer, so the shortest path through each visited
+    place once bounds it."""
+    r, start = robot.name, robot.start_location
+    used = m.new_bool_var(f'used_{r}')
+    m.add_max_equality(used, visits)
+    arcs, cost = [(0, 0, ~used)], []
+    for i, (place, visit) in enumerate(zip(places, visits, strict=True), start=1):
+        first = m.new_bool_var(f'route_first_{place}_{r}')
+        entry = (Fraction(0) if start is None
+                 else least_location_travel(problem, r, start, place))
+        last = m.new_bool_var(f'route_last_{place}_{r}')
+        arcs += [(i, i, ~visit), (0, i, first), (i, 0, last)]
+        cost.append(first * ticks(entry))
+        for j, other in enumerate(places, start=1):
+            if j != i:
+                leg = m.new_bool_var(f'route_{place}_{other}_{r}')
+                arcs.append((i, j, leg))
+                cost.append(leg * ticks(least_location_travel(problem, r, place, other)))
+    m.add_circuit(arcs)
+    return sum(cost)
