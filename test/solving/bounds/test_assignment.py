@@ -94,3 +94,4 @@ def test_a_robot_goes_from_one_place_to_the_next():
                       jobs=tuple(Job(site, site, ((1,),)) for site in 'xyz'),
                       distances=distances, locomote=2)
     assert fleet_load_bound(problem, 5) == 31 == solve(problem).makespan
+    assert fleet_load_bound(problem, 5, routes=False) == 21
