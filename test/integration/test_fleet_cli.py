@@ -4,6 +4,7 @@ it starts ends without a traceback, and only the fleet's planner can end the lau
 
 import copy
 import os
+import re
 import signal
 import subprocess
 import time
@@ -135,8 +136,14 @@ def test_forged_mission_statuses_do_not_end_the_fleet(tmp_path, ros_domain):
     assert process.returncode == 0, out + err
     assert 'complete: 12/12 jobs done' in out and 'makespan 1.25' not in out
     assert 'a forger says so' not in out + err
-    assert 'does not verify with the fleet key (not signed)' in err
-    assert 'mission statuses dropped: 4 that did not verify with the fleet key' in err
+    # The launcher's reader keeps the latest status only: on a loaded machine one forgery can
+    # replace another before it is taken, so the first one dropped may be either kind.
+    first = re.search(r'does not verify with the fleet key \((.*?)\); further ones', err)
+    assert first and (first.group(1) == 'not signed'
+                      or first.group(1).startswith("signature of 'planner' does not verify")), err
+    dropped = re.search(r'mission statuses dropped: (\d) that did not verify with the fleet key',
+                        err)
+    assert dropped and 1 <= int(dropped.group(1)) <= 4, err
 
 
 def test_a_cancelled_mission_still_gets_its_summary_and_chart(tmp_path, ros_domain):
