@@ -659,8 +659,7 @@ class RobotExecution:
         if (self.robot, job) in self._operation_done:
             end = self._job_end(job)
             if end is None and job not in self._job_robots:
-                end = max(fact.time for (_, done), fact in self._operation_done.items()
-                          if done == job)
+                end = self._latest_operation_end(job)
             if end is None:
                 return False
             self._free_at = max(self._free_at, end)
@@ -683,14 +682,19 @@ class RobotExecution:
         for job in task.predecessors:
             end = self._predecessor_end(job)
             if end is None and job not in self._job_robots:
-                end = max((fact.time for (_, done), fact in self._operation_done.items()
-                           if done == job), default=None)
+                end = self._latest_operation_end(job)
                 if end is None:
                     continue
             if end is None:
                 return None
             times.append(end)
         return max(times)
+
+    def _latest_operation_end(self, job: str) -> float | None:
+        """The latest end reported of the job's operations (None if none was): the end of a
+        job the revision leaves out, which was complete when it was planned."""
+        return max((fact.time for (_, done), fact in self._operation_done.items()
+                    if done == job), default=None)
 
     def _predecessor_end(self, job: str) -> float | None:
         """When a predecessor completed, as far as this robot may act on it: a job it took
