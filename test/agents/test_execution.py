@@ -629,6 +629,20 @@ def test_a_robot_recovered_at_a_job_it_finished_its_part_of_stays_until_the_job_
     assert kinds(r.step(10)) == [(ARRIVED, 'J2', 7), (STARTED, 'J2', 7), (DONE, 'J2', 8)]
 
 
+def test_a_robot_recovered_with_nothing_left_to_do_is_done_only_when_its_job_is():
+    r = RobotExecution('A')
+    plan(r, 1, [task('J1', 0, 1, end=5, co=['B'])], {'J1': {'A', 'B'}})
+    r.arrived('B', 'J1', 0.0, 1)
+    r.step(1.5)
+    r.fail(2)
+    r.recover(3)
+    plan(r, 2, [], {'J1': {'A', 'B'}}, now=3, continued=['J1'])
+    assert r.step(4) == [] and not r.finished
+    assert (r.mode, r.current_job) == (RobotMode.WAITING, 'J1')
+    r.operation_done('B', 'J1', 5.0, 1)
+    assert r.step(5) == [] and r.finished and r.mode == RobotMode.IDLE
+
+
 def test_a_robot_recovered_at_a_job_restarted_without_it_leaves_at_once():
     """Where the re-plan restarts that job without it, nothing holds it there."""
     r = RobotExecution('A')

@@ -614,10 +614,10 @@ class RobotExecution:
     def _next(self) -> bool:
         while self._index < len(self.tasks) and self._finished(self.tasks[self._index].job):
             self._index += 1
+        if not self._left_finished_job():
+            return False
         if self._index >= len(self.tasks):
             self._phase, self._holding = _Phase.DONE, ''
-            return False
-        if not self._left_finished_job():
             return False
         task = self.tasks[self._index]
         self._attempts[task.job] = self._attempts.get(task.job, 0) + 1
