@@ -49,5 +49,9 @@ if [[ "$(cat "$src_stamp" 2>/dev/null)" != "$src_hash" ]]; then
       > "$WS/log/colcon-build.out" 2>&1 \
       || { tail -n 40 "$WS/log/colcon-build.out" >&2; exit 1; }
   ) || fail "colcon build failed (full output: $WS/log/colcon-build.out)"
+  # Every node process imports the install space. Where PYTHONDONTWRITEBYTECODE is set, none
+  # may write its bytecode, so each would compile our sources again on every start.
+  "$VENV/bin/python" -m compileall -q "$WS/install" >/dev/null \
+    || fail "could not compile the install space's Python sources"
   echo "$src_hash" > "$src_stamp"
 fi
