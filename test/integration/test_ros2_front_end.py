@@ -85,13 +85,21 @@ def fleet(tmp_path_factory):
         yield fleet
 
 
+def takes_ctrl_c():
+    """Run in the command's process before it starts: a command typed in a terminal takes
+    Ctrl-C, even when these tests run in a background job (which ignores SIGINT, and its
+    children inherit that)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 class Run:
     """A `ros2` command as a user runs it in a shell: its output read as it comes, Ctrl-C
     once it is streaming."""
 
     def __init__(self, argv: list[str], env: dict, expected: str | None):
         self.process = subprocess.Popen(argv, env=env, cwd=REPO, text=True,
-                                        stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+                                        stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                        preexec_fn=takes_ctrl_c)
         self.stdout, self.interrupted = '', False
         reader = threading.Thread(target=self._read, daemon=True)
         reader.start()
@@ -248,7 +256,8 @@ def test_node_and_topic_info(fleet):
 ])
 def test_ctrl_c_ends_quietly(fleet, args, code):
     process = subprocess.Popen(['ros2', *args], env=fleet.env, text=True,
-                               stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                               preexec_fn=takes_ctrl_c)
     # Interrupted once it is on the graph (a loaded machine can take seconds to get there:
     # a Ctrl-C before is one at startup, not one ending the verb).
     fleet.wait_for(lambda o: f'_ros2cli_{process.pid}' in o.node.get_node_names(), 60,
