@@ -97,8 +97,7 @@ def waits_in_queue(records: list[Record]) -> bool:
 
 
 class Journal:
-    """Appends records to one mission's file; `write(..., sync=True)` returns once they
-    are on disk.
+    """Appends records to one mission's file; `write` returns once its record is on disk.
 
     A record that cannot be written whole (a full disk, a file size limit, a directory made
     read-only) is cut off again, so the file keeps every record before it and nothing of it,
@@ -115,7 +114,7 @@ class Journal:
             raise JournalError(f'{self.path}: cannot open the journal: '
                                f'{error.strerror or error}') from None
 
-    def write(self, record: Record, sync: bool = True) -> None:
+    def write(self, record: Record) -> None:
         data = (json.dumps(_encode(record), separators=(',', ':')) + '\n').encode()
         try:
             size = os.fstat(self._fd).st_size
@@ -125,8 +124,7 @@ class Journal:
             written = 0
             while written < len(data):
                 written += os.write(self._fd, data[written:])
-            if sync:
-                os.fsync(self._fd)
+            os.fsync(self._fd)
         except OSError as error:
             try:
                 os.ftruncate(self._fd, size)
@@ -134,17 +132,11 @@ class Journal:
                 pass  # a line cut short is ignored when read
             raise JournalError(self._failed(error)) from None
 
-    def sync(self) -> None:
-        try:
-            os.fsync(self._fd)
-        except OSError as error:
-            raise JournalError(self._failed(error)) from None
-
     def _failed(self, error: OSError) -> str:
         return f'{self.path}: cannot write the journal: {error.strerror or error}'
 
     def close(self) -> None:
-        """Close the file; what was written with `sync` is on disk already."""
+        """Close the file; what was written is on disk already."""
         if self._fd >= 0:
             fd, self._fd = self._fd, -1
             try:

@@ -743,12 +743,6 @@ class PlannerNode(Node):
             self.resume_unfinished()
             if self.journal_blocked is not None:
                 return
-        if self.journal is not None:
-            try:
-                self.journal.sync()
-            except JournalError as error:
-                self.set_aside(error)
-                return
         # Robots are judged silent by what has arrived, not by what the executor served.
         catch_up(self.task_events)
         catch_up(self.robot_states)
