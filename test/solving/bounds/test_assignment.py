@@ -9,6 +9,7 @@ from fjsp_planner.model.schedule import Status
 from fjsp_planner.solving.bounds.assignment import fleet_load_bound
 from fjsp_planner.solving.bounds.fleet import static_bound
 from fjsp_planner.solving.cpsat import solve_cpsat
+from fjsp_planner.solving.routed import LOAD_BOUND_WORK
 from fjsp_planner.solving.solve import solve
 
 
@@ -57,6 +58,16 @@ def test_a_robot_that_may_start_anywhere_enters_its_first_place_for_free():
     """W without a start location welds at a, then crosses to b: 2 + 5 + 2 = 9."""
     problem = welders([Robot('W', 'Welder')], [('x', 'a'), ('y', 'b')])
     assert fleet_load_bound(problem, 5) == 9 == solve(problem).makespan
+
+
+def test_the_work_given_beside_the_routed_search_proves_small_cases():
+    """Beside the routed search the bound stops after `LOAD_BOUND_WORK` of CP-SAT's
+    deterministic time, not after a share of wall time: enough for the three-jobs-at-a case
+    (6), whatever else runs on the machine."""
+    problem = welders([Robot('W1', 'Welder', start_location='a'),
+                       Robot('W2', 'Welder', start_location='b')],
+                      [('x1', 'a'), ('x2', 'a'), ('x3', 'a'), ('y', 'b')])
+    assert fleet_load_bound(problem, 5, work=LOAD_BOUND_WORK) == 6
 
 
 def test_running_jobs_get_none():

@@ -23,8 +23,15 @@ from fjsp_planner.solving.start import Start
 MIN_JOBS = 25
 """Up to this many jobs CP-SAT usually proves the optimum in seconds with both cores."""
 LOAD_BOUND_SHARE = 0.05
-"""Share of the time limit for the fleet load bound, on one core beside the search: it
-comes within 1 % of its optimum in about a second on 120 jobs."""
+"""Share of the time limit for the fleet load bound when it runs before CP-SAT (small
+scenarios, `solve`)."""
+LOAD_BOUND_WORK = 0.3
+"""Deterministic time (CP-SAT's measure of work, about seconds of one core) for the fleet
+load bound beside the search: it comes within a few % of its optimum in that on 30-120
+jobs, and beside a search on a busy machine a share of wall time may give it little of a
+core."""
+LOAD_BOUND_MOST_SHARE = 0.15
+"""Share of the time limit the fleet load bound may take beside the search at most."""
 CHAIN_BOUND_SHARE = 0.1
 """Share of the time limit for the chain bound, after the fleet load bound, beside the
 search."""
@@ -41,9 +48,11 @@ def applies(problem: Problem, start: Start, keep) -> bool:
 def search_free_bound(problem: Problem, time_limit: float,
                       incumbent: Fraction | None = None) -> Fraction | None:
     """The better of the fleet load bound and the chain bound, one after the other on one
-    core, each in its share of `time_limit`; None when neither applies."""
+    core: the first until it has done `LOAD_BOUND_WORK` (within its most share of
+    `time_limit`), the second in its share; None when neither applies."""
     found = [bound for bound in (
-        fleet_load_bound(problem, LOAD_BOUND_SHARE * time_limit, incumbent=incumbent),
+        fleet_load_bound(problem, LOAD_BOUND_MOST_SHARE * time_limit, incumbent=incumbent,
+                         work=LOAD_BOUND_WORK),
         chain_bound(problem, CHAIN_BOUND_SHARE * time_limit, incumbent=incumbent))
         if bound is not None]
     return max(found, default=None)

@@ -29,13 +29,16 @@ go without this bound."""
 
 
 def fleet_load_bound(problem: Problem, time_limit: float, workers: int = 1,
-                     incumbent: Fraction | None = None, routes: bool = True
-                     ) -> Fraction | None:
+                     incumbent: Fraction | None = None, routes: bool = True,
+                     work: float | None = None) -> Fraction | None:
     """The bound of the module docstring, or None when it does not apply (running jobs, too
     many staffings) or CP-SAT proves nothing in `time_limit` seconds. With `incumbent`, a
     makespan known to be reachable, it never exceeds that. Without `routes`, each robot's
     way through its places is left out: one least leg into each place only, a model proven
-    in tenths of a second where the routes take seconds."""
+    in tenths of a second where the routes take seconds. With `work`, CP-SAT also stops
+    after that much deterministic time (its own measure of work done, about seconds of one
+    core whatever the load), so that the bound is as strong on a busy machine as on an idle
+    one, within `time_limit`."""
     if problem.fixed or not problem.jobs:
         return None
     robots = sorted(r.name for r in problem.robots)
@@ -117,6 +120,8 @@ def fleet_load_bound(problem: Problem, time_limit: float, workers: int = 1,
     # Only the bound is wanted: with the circuits' and every constraint's cuts in its LP,
     # CP-SAT proves far more of it in the same time (docs/solver.md, "Fleet load").
     solver.parameters.linearization_level = 2
+    if work is not None:
+        solver.parameters.max_deterministic_time = work
     status = solver.solve(m).name
     if status in ('MODEL_INVALID', 'INFEASIBLE') or not math.isfinite(
             solver.best_objective_bound):
