@@ -4,8 +4,9 @@ search side by side, from the start (docs/solver.md, "Local search").
 CP-SAT runs in a thread of its own from the start's schedule, for its bound and its own
 improvements; the local search (`local`) runs meanwhile from the same schedule, and the
 fleet load and chain bounds (`bounds.assignment`, `bounds.chains`) one after the other in a
-thread of their own, each for a short share of the limit. The shorter schedule wins; the
-bound is the best of CP-SAT's, the static bound and those two.
+thread of their own, each briefly (the first for a fixed amount of CP-SAT's work, the second
+for a share of the limit). The shorter schedule wins; the bound is the best of CP-SAT's, the
+static bound and those two.
 """
 
 import time
