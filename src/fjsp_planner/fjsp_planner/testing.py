@@ -37,7 +37,9 @@ from collections import Counter, defaultdict
 from fractions import Fraction
 
 import pytest
+from rclpy.serialization import deserialize_message
 
+from fjsp_common.auth import Verifier, read_key
 from fjsp_common.clock import ScheduleClock, seconds
 from fjsp_common.contract import (
     JOB_STATES,
@@ -148,9 +150,13 @@ def _test_domains() -> tuple[range, str]:
 class Observer(Listener):
     """Records every public topic of one domain, from the test process."""
 
-    def __init__(self, domain: int, dds: dict | None = None):
+    def __init__(self, domain: int, dds: dict | None = None, key_file=None):
         """`dds`: the DDS_VARIABLES the fleet's nodes have (default: discovery on this
-        host only)."""
+        host only). With the fleet's `key_file`, it screens what it hears as the nodes do
+        (`Verifier.screen`): a flood of unsigned messages is dropped from its bytes, past the
+        first few a second, instead of each being decoded in the test's process. It records
+        signed messages whether they verify or not."""
+        self._verifier = Verifier(read_key(key_file)) if key_file is not None else None
         dds = {'ROS_AUTOMATIC_DISCOVERY_RANGE': DISCOVERY_RANGE, **(dds or {})}
         # Fast DDS reads its transports when the node's participant is made, after init.
         with environment(**dds):
@@ -170,6 +176,21 @@ class Observer(Listener):
                                 (JOB_STATES, lambda msg: setattr(self, 'job_states', msg)),
                                 (ROBOT_STATES, self._robot)):
             self.subscribe(topic.type, topic.name, topic.qos, callback)
+
+    def subscribe(self, msg_type, topic: str, qos, callback):
+        if self._verifier is None:
+            return super().subscribe(msg_type, topic, qos, callback)
+        resolved = self.node.resolve_topic_name(topic)
+
+        def screened(data: bytes) -> None:
+            if not self._verifier.screen(data, resolved):
+                return
+            try:
+                msg = deserialize_message(data, msg_type)
+            except Exception:  # noqa: BLE001  bytes rclpy cannot read, whatever it raises
+                return
+            callback(msg)
+        return super().subscribe(msg_type, topic, qos, screened, raw=True)
 
     def _robot(self, msg: RobotState) -> None:
         self.robots[msg.robot] = msg
@@ -242,7 +263,7 @@ class FleetHarness(Fleet):
                              planner={**TEST_PLANNER, **(planner or {})},
                              env={**dds, **(env or {})}, **options)
             self.observer = Observer(domain, {k: self.env[k] for k in DDS_VARIABLES
-                                              if k in self.env})
+                                              if k in self.env}, self.key_file)
         except BaseException:
             if self.claim is not None:
                 self.claim.release()

@@ -48,12 +48,12 @@ class Listener:
             if self.context.ok():
                 raise
 
-    def subscribe(self, msg_type, topic: str, qos, callback):
+    def subscribe(self, msg_type, topic: str, qos, callback, raw: bool = False):
         def locked(msg):
             with self.lock:
                 callback(msg)
                 self.lock.notify_all()
-        return self.node.create_subscription(msg_type, topic, locked, qos)
+        return self.node.create_subscription(msg_type, topic, locked, qos, raw=raw)
 
     def wait_for(self, predicate, timeout: float) -> bool:
         """Wait until `predicate()` holds (checked under the lock at every message); whether
