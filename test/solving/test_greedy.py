@@ -3,19 +3,20 @@
 import pytest
 
 from fjsp_planner.model.generator import Shape, random_scenario
-from fjsp_planner.model.scenario import parse_scenario
+from fjsp_planner.model.scenario import load_scenario, parse_scenario
 from fjsp_planner.model.validate import validate
 from fjsp_planner.solving.greedy import greedy_schedule
 from fjsp_planner.solving.solve import solve
 
+from repo_paths import DATA
+
 
 def test_two_holding_arcs_whose_held_jobs_wait_for_each_other_are_placed():
-    """`random_scenario(0)`: arc Wire-1 -> Mount-4 (torque) and arc Join-2 -> Place-5
-    (clamp), with Join-2 before Mount-4 and Wire-1 before Place-5. Neither arc can be placed
-    as one block, and only the two drones torque: Wire-1 takes both, Join-2 needs one. So
-    Join-2 goes first, its clamps kept for Place-5, then Wire-1 with both drones, then
-    Mount-4 and Place-5."""
-    problem = parse_scenario(random_scenario(0))
+    """Arc Wire-1 -> Mount-4 (torque) and arc Join-2 -> Place-5 (clamp), with Join-2 before
+    Mount-4 and Wire-1 before Place-5. Neither arc can be placed as one block, and only the
+    two drones torque: Wire-1 takes both, Join-2 needs one. So Join-2 goes first, its clamps
+    kept for Place-5, then Wire-1 with both drones, then Mount-4 and Place-5."""
+    problem = load_scenario(DATA / 'holding_arcs_waiting_for_each_other.yaml')
     assert ('Wire-1', 'Mount-4', 2) in problem.holding
     assert ('Join-2', 'Place-5', 0) in problem.holding
     schedule = greedy_schedule(problem)
@@ -24,9 +25,10 @@ def test_two_holding_arcs_whose_held_jobs_wait_for_each_other_are_placed():
     assert jobs['Join-2'].end <= jobs['Wire-1'].start
 
 
-@pytest.mark.parametrize('seed', [64, 65])
-def test_interleaved_holding_arcs_of_larger_scenarios_are_placed(seed):
-    problem = parse_scenario(random_scenario(seed))
+@pytest.mark.parametrize('name', ['interleaved_holding_arcs_17_jobs',
+                                  'interleaved_holding_arcs_28_jobs'])
+def test_interleaved_holding_arcs_of_larger_scenarios_are_placed(name):
+    problem = load_scenario(DATA / f'{name}.yaml')
     assert validate(problem, greedy_schedule(problem)) == []
 
 

@@ -18,7 +18,11 @@ Valid by construction means every scenario loads and has a schedule:
   staff the rest of both jobs; a job is in at most one holding arc, so no robot is sent
   directly from one job to two;
 - j' has no predecessor that follows j, so no precedence path runs around the arc: the
-  holders never wait for a job that needs j done and them free.
+  holders never wait for a job that needs j done and them free;
+- with every holding arc's two jobs taken as one, the precedence graph has no cycle: two arcs
+  must not each need the other's first job done before their held job, or robots holding in
+  both could do neither first. Doing the merged jobs one at a time in a topological order is
+  then a schedule.
 """
 
 import itertools
@@ -214,6 +218,8 @@ class _Draw:
                 if not free:
                     continue
                 target = rng.choice(free)
+                if target in _cycle_closers(source, arcs, precedence):
+                    continue
                 held = self._held_plans(rng.choice(self.work), jobs[source], jobs[target])
                 if held is None:
                     continue
@@ -270,6 +276,34 @@ def _matching(operations, able, taken) -> bool:
     q, rest = operations[0], operations[1:]
     return any(_matching(rest, able, taken | {robot})
                for robot in able[q] if robot not in taken)
+
+
+def _cycle_closers(source: str, arcs, precedence) -> set[str]:
+    """The jobs that, held from `source`, would close a cycle in the precedence graph where
+    each of `arcs` is one node: those reached from `source` through another node, and those
+    `source` is reached from."""
+    merged = {held: first for first, held, *_ in arcs}
+    successors, predecessors = {}, {}
+    for before, after in precedence:
+        before, after = merged.get(before, before), merged.get(after, after)
+        if before != after:
+            successors.setdefault(before, set()).add(after)
+            predecessors.setdefault(after, set()).add(before)
+    source = merged.get(source, source)
+    through = {far for near in successors.get(source, ()) for far in successors.get(near, ())}
+    return _reached(through, successors) | _reached(predecessors.get(source, set()),
+                                                    predecessors)
+
+
+def _reached(starts: set[str], edges: dict[str, set[str]]) -> set[str]:
+    """`starts` and every node reached from them along `edges`."""
+    seen, todo = set(starts), list(starts)
+    while todo:
+        for nxt in edges.get(todo.pop(), ()):
+            if nxt not in seen:
+                seen.add(nxt)
+                todo.append(nxt)
+    return seen
 
 
 def _holdable(q, holders: int, plans, able) -> bool:
