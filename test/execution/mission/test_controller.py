@@ -70,6 +70,7 @@ class Fleet:
         self.problem = problem
         self.controller = MissionController(settings)
         self.wall = 1000.0
+        self.refused = 0
         self.effects = []
         self.failures = dict.fromkeys(ROBOTS, 0)
         self.incarnations = dict.fromkeys(ROBOTS, 1)
@@ -107,14 +108,16 @@ class Fleet:
         for robot in robots:
             self.report(robot)
 
-    def tick(self, advance=0.1, robots=ROBOTS):
-        """Advance the clock in heartbeat-sized steps, robots in `robots` reporting."""
+    def tick(self, advance=0.1, robots=ROBOTS, refused_per_second=0):
+        """Advance the clock in heartbeat-sized steps, robots in `robots` reporting and the
+        node refusing `refused_per_second` unauthenticated messages meanwhile."""
         effects = []
         steps = max(1, round(advance / 0.1))
         for _ in range(steps):
             self.wall += advance / steps
+            self.refused += round(refused_per_second * advance / steps)
             self.heartbeat(robots)
-            effects += self.take(self.controller.tick(self.wall))
+            effects += self.take(self.controller.tick(self.wall, refused=self.refused))
         return effects
 
     def tick_until_solve(self, ticks=20):
@@ -420,6 +423,24 @@ def test_a_robot_silent_while_the_others_are_heard_is_offline_after_the_timeout(
     fleet = executing(problem)
     assert not notes(fleet.tick(advance=0.9, robots=ROBOTS[1:]), MissionEventKind.ROBOT_OFFLINE)
     effects = fleet.tick(advance=0.3, robots=ROBOTS[1:])
+    assert [n.robot for n in notes(effects, MissionEventKind.ROBOT_OFFLINE)] == [ROBOTS[0]]
+
+
+def test_under_a_flood_a_robot_is_offline_only_after_five_timeouts(problem):
+    """A flood of unsigned messages makes the node's subscriptions drop what it cannot read,
+    a robot's states among them: a robot unheard for a few timeouts then is no evidence."""
+    fleet = executing(problem)
+    flood = {'robots': ROBOTS[1:], 'refused_per_second': 8000}
+    assert not notes(fleet.tick(advance=4.8, **flood), MissionEventKind.ROBOT_OFFLINE)
+    (offline,) = notes(fleet.tick(advance=0.4, **flood), MissionEventKind.ROBOT_OFFLINE)
+    assert offline.robot == ROBOTS[0]
+    assert 'under a flood of 8,000 unauthenticated messages a second' in offline.reasons[0]
+
+
+def test_a_few_refused_messages_are_no_flood(problem):
+    """An agent without the key sends a few states a second: no reason to judge slower."""
+    fleet = executing(problem)
+    effects = fleet.tick(advance=1.2, robots=ROBOTS[1:], refused_per_second=20)
     assert [n.robot for n in notes(effects, MissionEventKind.ROBOT_OFFLINE)] == [ROBOTS[0]]
 
 

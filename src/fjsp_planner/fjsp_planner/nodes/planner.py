@@ -746,7 +746,8 @@ class PlannerNode(Node):
         # Robots are judged silent by what has arrived, not by what the executor served.
         catch_up(self.task_events)
         catch_up(self.robot_states)
-        self.carry_out(self.controller.tick(self.wall(), self.plan_pub.get_subscription_count()))
+        self.carry_out(self.controller.tick(self.wall(), self.plan_pub.get_subscription_count(),
+                                            self.auth.rejected))
 
     def on_robot_state(self, msg: RobotState) -> None:
         why = self.auth.refusal(msg, ROBOT_STATES_TOPIC, {msg.robot})

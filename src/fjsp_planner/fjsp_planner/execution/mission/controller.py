@@ -447,9 +447,14 @@ class MissionController:
 
     # --- time passing --------------------------------------------------------------------
 
-    def tick(self, wall: float, subscribers: int | None = None) -> list[Effect]:
+    def tick(self, wall: float, subscribers: int | None = None,
+             refused: int | None = None) -> list[Effect]:
         """Judge heartbeats, start what is due. `subscribers` counts the plan topic's
-        matched readers: the first plan waits until every robot can hear it."""
+        matched readers: the first plan waits until every robot can hear it. `refused` counts
+        the messages the node has refused as unauthenticated so far: a flood of them slows
+        the judgment of heartbeats."""
+        if refused is not None:
+            self.liveness.count_refused(refused, wall)
         starved = self.liveness.starved(wall)
         effects: list[Effect] = []
         if not starved:
@@ -505,9 +510,11 @@ class MissionController:
             if not change.back:
                 mission.tracker.mark_offline(change.robot, at=self._units(mission, wall))
                 unverified = self.liveness.silenced(change.robot)
+                flood = (f' under a flood of {self.liveness.refused_rate():,.0f} '
+                         'unauthenticated messages a second' if self.liveness.flooded() else '')
                 effects.append(Note(MissionEventKind.ROBOT_OFFLINE, (
-                    f'no state that verifies for {change.silent:.1f} s: {unverified}'
-                    if unverified else f'no state for {change.silent:.1f} s',),
+                    f'no state that verifies for {change.silent:.1f} s{flood}: {unverified}'
+                    if unverified else f'no state for {change.silent:.1f} s{flood}',),
                     robot=change.robot))
             else:
                 report = self.liveness.agents[change.robot].report

@@ -12,9 +12,14 @@ core), not of failed robots. When no robot at all is heard, they go offline afte
 FLEET_SILENCE timeouts: the planner cannot tell its own stall from a fleet-wide loss then.
 States that do not verify with the fleet key are no heartbeat, but they are remembered: a
 robot whose agent lacks the key is said to be unverified rather than merely silent.
+Under a flood of unauthenticated messages (more than FLOOD_RATE refused a second) the
+subscriptions drop messages the planner never reads, its robots' states among them, at random:
+heartbeats are then judged over FLOOD_STRETCH timeouts, so a flood slows the detection of a
+lost robot instead of inventing one.
 """
 
 import math
+from collections import deque
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -38,6 +43,18 @@ to the writer at all."""
 
 FLEET_SILENCE = 3
 """Heartbeat timeouts after which robots are offline although no robot was heard since."""
+
+FLOOD_RATE = 200
+"""Messages refused as unauthenticated per second beyond which the node is flooded: a fleet
+member without the key sends a few states a second, a flooder thousands."""
+
+FLOOD_STRETCH = 5
+"""Heartbeat timeouts a robot may stay unheard while the node is flooded: at 5 states a
+second, a robot's states all lost for five timeouts at once is unlikely even when most of
+what the node could read is dropped."""
+
+FLOOD_WINDOW = 2.0
+"""Seconds over which the rate of refused messages is measured."""
 
 STARVED = 0.25
 """Seconds between two ticks beyond which the node could not take messages for a while: the
@@ -95,6 +112,22 @@ class Liveness:
         self.unverified: dict[str, tuple[str, float]] = {}
         """Robot -> (why, when) of the latest state about it that did not verify."""
         self._last_tick: float | None = None
+        self._refusals: deque[tuple[float, int]] = deque()
+
+    def count_refused(self, refused: int, wall: float) -> None:
+        """Take the node's running count of messages refused as unauthenticated at `wall`."""
+        self._refusals.append((wall, refused))
+        while len(self._refusals) > 2 and wall - self._refusals[1][0] >= FLOOD_WINDOW:
+            self._refusals.popleft()
+
+    def refused_rate(self) -> float:
+        """Messages refused per second over the latest FLOOD_WINDOW or so (0 before two
+        counts)."""
+        (first, first_count), (last, last_count) = self._refusals[0], self._refusals[-1]
+        return (last_count - first_count) / (last - first) if last > first else 0.0
+
+    def flooded(self) -> bool:
+        return bool(self._refusals) and self.refused_rate() > FLOOD_RATE
 
     def hear(self, report: RobotReport, wall: float) -> bool:
         """Take a robot's state; whether its agent restarted since its previous one."""
@@ -147,7 +180,10 @@ class Liveness:
     def check_heartbeats(self, wall: float, timeout: float) -> list[HeartbeatChange]:
         """The agents that went offline at `wall` (no state for more than `timeout` before the
         latest state of any robot, or for FLEET_SILENCE timeouts) and those that count again
-        (heard for a full `timeout` after an offline spell)."""
+        (heard for a full `timeout` after an offline spell); FLOOD_STRETCH timeouts when
+        flooded."""
+        if self.flooded():
+            timeout *= FLOOD_STRETCH
         changes = []
         latest = max((agent.heard for agent in self.agents.values()), default=wall)
         for name, agent in self.agents.items():
