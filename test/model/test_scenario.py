@@ -15,6 +15,8 @@ from fjsp_planner.model.scenario import (
     parse_scenario,
     scenario_warnings,
 )
+from fjsp_planner.model.schedule import JobAssignment, Schedule
+from fjsp_planner.model.validate import validate
 
 from repo_paths import PAPER
 
@@ -196,6 +198,47 @@ def test_a_job_no_robot_can_do():
     assert caught.value.problems == [
         "job 'M1' cannot be staffed: plan 0 ['solder' (4)] needs a robot able to do it; no "
         'robot can']
+
+
+def two_holds(extra_robots=()) -> dict:
+    """Two holding arcs, each held job waiting for the other arc's first job: J1 -> H1
+    holding grip, J2 -> H2 holding torque, with J1 before H2 and J2 before H1."""
+    return {
+        'operation_types': {0: 'grip', 1: 'torque', 2: 'drive'},
+        'robot_types': {'Gripper': {'grip': 2, 'drive': 1}, 'Both': {'grip': 3, 'torque': 3,
+                                                                    'drive': 1},
+                        'Turner': {'torque': 2, 'drive': 1}},
+        'robots': [{'name': 'A', 'type': 'Gripper'}, {'name': 'B', 'type': 'Both'},
+                   {'name': 'C', 'type': 'Turner'}, *extra_robots],
+        'jobs': [{'name': name, 'location': 'yard', 'plans': [[op, op]]}
+                 for name, op in (('J1', 'grip'), ('J2', 'torque'), ('H1', 'grip'),
+                                  ('H2', 'torque'))],
+        'precedence': [['J1', 'H2'], ['J2', 'H1']],
+        'holding': [['J1', 'H1', 'grip'], ['J2', 'H2', 'torque']],
+    }
+
+
+def test_two_holding_arcs_that_must_share_a_holder_and_wait_for_each_other_are_refused():
+    """B is the only robot able to do both: two grip and two torque holders among three
+    robots put it in both arcs, and it could do neither arc first."""
+    with pytest.raises(ProblemError) as caught:
+        parse_scenario(two_holds())
+    assert caught.value.problems == [
+        "holding arcs ('J1', 'H1', 'grip' (0)) and ('J2', 'H2', 'torque' (1)) cannot both be "
+        "held: 'H1' waits for 'J2' and 'H2' for 'J1', and 4 holders among the 3 robots able "
+        "to do 'grip' (0) or 'torque' (1) put one in both arcs, which it could do neither of "
+        'first']
+
+
+def test_two_holding_arcs_waiting_for_each_other_with_holders_enough_are_kept():
+    """With a second robot able to do both, A and D hold the grip and B and C the torque."""
+    problem = parse_scenario(two_holds([{'name': 'D', 'type': 'Both'}]))
+    grip, torque = {'A': 0, 'D': 0}, {'B': 1, 'C': 1}
+    schedule = Schedule(
+        {'J1': JobAssignment('J1', 0, 0, 3, grip), 'J2': JobAssignment('J2', 0, 0, 3, torque),
+         'H1': JobAssignment('H1', 0, 3, 6, grip), 'H2': JobAssignment('H2', 0, 3, 6, torque)},
+        {'A': ('J1', 'H1'), 'D': ('J1', 'H1'), 'B': ('J2', 'H2'), 'C': ('J2', 'H2')})
+    assert validate(problem, schedule) == []
 
 
 def test_every_problem_is_reported_at_once(paper_data):

@@ -5,6 +5,7 @@ before a solver decides how to put them on its own grid.
 """
 
 import difflib
+import itertools
 from collections import Counter
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
@@ -354,6 +355,47 @@ def _holding_problems(p: Problem) -> list[str]:
         seen_from[a, q] = b
         seen_to[b, q] = a
     return problems
+
+
+def holding_deadlocks(p: Problem) -> list[str]:
+    """Pairs of holding arcs no schedule can hold: each held job waits (along precedence and
+    holding arcs) for the other arc's first job, and the arcs need more holders than there
+    are robots able to hold in either, so some robot holds in both. Doing its arcs in either
+    order, it would start one held job before the first job that job waits for. Arcs into or
+    out of fixed jobs are left out: their holders are given."""
+    arcs = [(a, b, q) for a, b, q in p.holding if a not in p.fixed and b not in p.fixed]
+    successors: dict[str, set[str]] = {j.name: set() for j in p.jobs}
+    for a, b in list(p.precedence) + [(a, b) for a, b, _ in p.holding]:
+        successors[a].add(b)
+    after: dict[str, set[str]] = {}
+    for a, _, _ in arcs:
+        seen, todo = set(), [a]
+        while todo:
+            for nxt in successors[todo.pop()] - seen:
+                seen.add(nxt)
+                todo.append(nxt)
+        after[a] = seen
+    problems = []
+    for (a, b, q), (c, d, r) in itertools.combinations(arcs, 2):
+        if not (d in after[a] and b in after[c]):
+            continue
+        able = {robot.name for robot in p.robots
+                if p.duration(robot.name, q) is not None or p.duration(robot.name, r) is not None}
+        holders = _least_count(p, a, q) + _least_count(p, c, r)
+        if holders > len(able):
+            either = p.operation_label(q) + ('' if q == r else f' or {p.operation_label(r)}')
+            problems.append(
+                f"holding arcs ('{a}', '{b}', {p.operation_label(q)}) and ('{c}', '{d}', "
+                f'{p.operation_label(r)}) cannot both be held: '
+                f"'{b}' waits for '{c}' and '{d}' for '{a}', and {holders} holders among the "
+                f'{len(able)} robots able to do {either} put one in both arcs, which it could '
+                'do neither of first')
+    return problems
+
+
+def _least_count(p: Problem, job: str, q: int) -> int:
+    """The fewest operations of type q in a plan of `job`: its fewest holders."""
+    return min(plan.count(q) for plan in p.job(job).plans)
 
 
 def _staffing_problems(p: Problem) -> list[str]:

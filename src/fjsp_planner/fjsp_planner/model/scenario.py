@@ -15,7 +15,15 @@ from fjsp_common.decimals import decimals
 from fjsp_planner.model import limits
 from fjsp_planner.model.limits import MAX_COORDINATE, MAX_TIME, load_yaml, shown
 from fjsp_planner.model.places import euclidean_distances, on_grid, panel_coordinates
-from fjsp_planner.model.problem import Job, Problem, ProblemError, Robot, listed, suggestion
+from fjsp_planner.model.problem import (
+    Job,
+    Problem,
+    ProblemError,
+    Robot,
+    holding_deadlocks,
+    listed,
+    suggestion,
+)
 
 DEFAULT_SHIFT = Fraction(60)
 
@@ -409,6 +417,8 @@ def _from_mapping(data, default_name, panels=None, shift=None):
     except ProblemError as error:
         read.problems += [p for p in error.problems
                           if not any(c in p for c in read.consequences)]
+    else:
+        read.problems += holding_deadlocks(problem)
     if read.problems:
         raise ProblemError(list(dict.fromkeys(read.problems)))
     return problem, file_panels
