@@ -482,7 +482,8 @@ class RobotAgent(Node):
             current_job=execution.current_job, location=execution.location,
             destination=execution.destination,
             progress=execution.progress(now) if now is not None else 0.0,
-            busy_until=execution.busy_until, last_event_id=self.last_event_id),
+            busy_until=execution.busy_until, last_event_id=self.last_event_id,
+            refused=self.auth.rejected),
             ROBOT_STATES_TOPIC))
 
 

@@ -437,6 +437,18 @@ def test_under_a_flood_a_robot_is_offline_only_after_five_timeouts(problem):
     assert 'under a flood of 8,000 unauthenticated messages a second' in offline.reasons[0]
 
 
+def test_a_flood_an_agent_reports_makes_the_planner_judge_slower_too(problem):
+    """Forged plans flood the agents, not the planner: their states come late, and say so."""
+    fleet = executing(problem)
+    effects = []
+    for step in range(1, 49):
+        fleet.wall += 0.1
+        for robot in ROBOTS[1:]:
+            fleet.report(robot, refused=800 * step)
+        effects += fleet.take(fleet.controller.tick(fleet.wall, refused=0))
+    assert not notes(effects, MissionEventKind.ROBOT_OFFLINE)
+
+
 def test_a_few_refused_messages_are_no_flood(problem):
     """An agent without the key sends a few states a second: no reason to judge slower."""
     fleet = executing(problem)

@@ -764,7 +764,7 @@ class PlannerNode(Node):
             revision=msg.plan_revision, refusal=msg.refusal, failures=msg.failures,
             robot_type=msg.robot_type, location=msg.location, destination=msg.destination,
             busy_until=msg.busy_until, progress=msg.progress, current_job=msg.current_job,
-            last_event=msg.last_event_id)
+            last_event=msg.last_event_id, refused=msg.refused)
         self.carry_out(self.controller.robot_state(report, self.wall()))
 
     def on_event(self, msg: TaskEvent) -> None:

@@ -510,8 +510,9 @@ class MissionController:
             if not change.back:
                 mission.tracker.mark_offline(change.robot, at=self._units(mission, wall))
                 unverified = self.liveness.silenced(change.robot)
-                flood = (f' under a flood of {self.liveness.refused_rate():,.0f} '
-                         'unauthenticated messages a second' if self.liveness.flooded() else '')
+                flood = (f' under a flood of {self.liveness.refused_rate(wall):,.0f} '
+                         'unauthenticated messages a second'
+                         if self.liveness.flooded(wall) else '')
                 effects.append(Note(MissionEventKind.ROBOT_OFFLINE, (
                     f'no state that verifies for {change.silent:.1f} s{flood}: {unverified}'
                     if unverified else f'no state for {change.silent:.1f} s{flood}',),

@@ -12,10 +12,11 @@ core), not of failed robots. When no robot at all is heard, they go offline afte
 FLEET_SILENCE timeouts: the planner cannot tell its own stall from a fleet-wide loss then.
 States that do not verify with the fleet key are no heartbeat, but they are remembered: a
 robot whose agent lacks the key is said to be unverified rather than merely silent.
-Under a flood of unauthenticated messages (more than FLOOD_RATE refused a second) the
-subscriptions drop messages the planner never reads, its robots' states among them, at random:
-heartbeats are then judged over FLOOD_STRETCH timeouts, so a flood slows the detection of a
-lost robot instead of inventing one.
+Under a flood of unauthenticated messages (more than FLOOD_RATE refused a second by the
+planner, or by an agent as its states say) the planner's subscriptions drop messages it never
+reads, its robots' states among them, at random, and flooded agents publish late: heartbeats
+are then judged over FLOOD_STRETCH timeouts, so a flood slows the detection of a lost robot
+instead of inventing one.
 """
 
 import math
@@ -101,6 +102,31 @@ class RecentEvents:
         return event_id in self._ids
 
 
+class RefusalRate:
+    """How fast a running count of refused messages grows, over the latest FLOOD_WINDOW."""
+
+    def __init__(self):
+        self._samples: deque[tuple[float, int]] = deque()
+
+    def count(self, refused: int, wall: float) -> None:
+        """Take the count as it is at `wall`."""
+        self._samples.append((wall, refused))
+        while len(self._samples) > 2 and wall - self._samples[1][0] >= FLOOD_WINDOW:
+            self._samples.popleft()
+
+    def clear(self) -> None:
+        """Forget the counts (a new process counts from 0)."""
+        self._samples.clear()
+
+    def per_second(self, wall: float) -> float:
+        """Refused a second lately; 0 before two counts, or when the latest is older than
+        FLOOD_WINDOW at `wall`."""
+        if len(self._samples) < 2 or wall - self._samples[-1][0] > FLOOD_WINDOW:
+            return 0.0
+        (first, first_count), (last, last_count) = self._samples[0], self._samples[-1]
+        return max(0, last_count - first_count) / (last - first) if last > first else 0.0
+
+
 class Liveness:
     """What is known of every robot's agent, across missions: its latest report, when it was
     heard, its offline spells and the task events received from it."""
@@ -112,22 +138,23 @@ class Liveness:
         self.unverified: dict[str, tuple[str, float]] = {}
         """Robot -> (why, when) of the latest state about it that did not verify."""
         self._last_tick: float | None = None
-        self._refusals: deque[tuple[float, int]] = deque()
+        self.node_refusals = RefusalRate()
+        """Messages this node refused as unauthenticated."""
+        self.agent_refusals: dict[str, RefusalRate] = {}
+        """Per robot, those its agent says it refused."""
 
     def count_refused(self, refused: int, wall: float) -> None:
         """Take the node's running count of messages refused as unauthenticated at `wall`."""
-        self._refusals.append((wall, refused))
-        while len(self._refusals) > 2 and wall - self._refusals[1][0] >= FLOOD_WINDOW:
-            self._refusals.popleft()
+        self.node_refusals.count(refused, wall)
 
-    def refused_rate(self) -> float:
-        """Messages refused per second over the latest FLOOD_WINDOW or so (0 before two
-        counts)."""
-        (first, first_count), (last, last_count) = self._refusals[0], self._refusals[-1]
-        return (last_count - first_count) / (last - first) if last > first else 0.0
+    def refused_rate(self, wall: float) -> float:
+        """The most unauthenticated messages a second that this node or an agent refused
+        lately."""
+        rates = [self.node_refusals, *self.agent_refusals.values()]
+        return max(rate.per_second(wall) for rate in rates)
 
-    def flooded(self) -> bool:
-        return bool(self._refusals) and self.refused_rate() > FLOOD_RATE
+    def flooded(self, wall: float) -> bool:
+        return self.refused_rate(wall) > FLOOD_RATE
 
     def hear(self, report: RobotReport, wall: float) -> bool:
         """Take a robot's state; whether its agent restarted since its previous one."""
@@ -142,6 +169,10 @@ class Liveness:
             if restarted:
                 agent.reachable_since = wall
             agent.report, agent.heard = report, wall
+        refusals = self.agent_refusals.setdefault(report.robot, RefusalRate())
+        if restarted:
+            refusals.clear()
+        refusals.count(report.refused, wall)
         return restarted
 
     def refuse(self, robot: str, why: str, wall: float) -> None:
@@ -182,7 +213,7 @@ class Liveness:
         latest state of any robot, or for FLEET_SILENCE timeouts) and those that count again
         (heard for a full `timeout` after an offline spell); FLOOD_STRETCH timeouts when
         flooded."""
-        if self.flooded():
+        if self.flooded(wall):
             timeout *= FLOOD_STRETCH
         changes = []
         latest = max((agent.heard for agent in self.agents.values()), default=wall)

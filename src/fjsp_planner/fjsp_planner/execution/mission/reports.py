@@ -25,6 +25,8 @@ class RobotReport:
     current_job: str = ''
     last_event: str = ''
     """The id of the latest task event the agent published ('' if none)."""
+    refused: int = 0
+    """Messages the agent's process has refused as unauthenticated so far."""
 
 
 @dataclass(frozen=True)
