@@ -23,9 +23,9 @@ from rclpy.time import Time
 from fjsp_common.contract import (
     EVENTS_QOS,
     LATCHED_QOS,
+    LATCHED_READER_QOS,
     MISSION_STATUS_TOPIC,
     PLAN_TOPIC,
-    ROBOT_STATES_QOS,
     ROBOT_STATES_TOPIC,
     TASK_EVENTS_TOPIC,
 )
@@ -64,7 +64,7 @@ class Recorder(Listener):
         self.last_job_done = None
         self.subscribe(Plan, PLAN_TOPIC, LATCHED_QOS, self.on_plan)
         self.subscribe(MissionStatus, MISSION_STATUS_TOPIC, LATCHED_QOS, self.on_status)
-        self.subscribe(RobotState, ROBOT_STATES_TOPIC, ROBOT_STATES_QOS, self.on_robot)
+        self.subscribe(RobotState, ROBOT_STATES_TOPIC, LATCHED_READER_QOS, self.on_robot)
         self.subscribe(TaskEvent, TASK_EVENTS_TOPIC, EVENTS_QOS, self.on_event)
 
     def on_plan(self, msg):

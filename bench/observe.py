@@ -33,8 +33,8 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / 'test' / 'integration'))
 
 from fjsp_common.contract import (  # noqa: E402
+    LATCHED_READER_QOS,
     MODE_FROM_MSG,
-    ROBOT_STATES_QOS,
     ROBOT_STATES_TOPIC,
 )
 from fjsp_msgs.msg import MissionStatus, RobotState  # noqa: E402
@@ -70,7 +70,7 @@ def record_robot_states(observer) -> list:
     latest of each writer, and would miss short-lived states)."""
     states = []
     observer.node.create_subscription(RobotState, ROBOT_STATES_TOPIC, states.append,
-                                      ROBOT_STATES_QOS)
+                                      LATCHED_READER_QOS)
     return states
 
 

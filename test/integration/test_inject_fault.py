@@ -8,7 +8,7 @@ import pytest
 import rclpy
 from rclpy.executors import SingleThreadedExecutor
 
-from fjsp_common.contract import ROBOT_STATES_QOS, ROBOT_STATES_TOPIC
+from fjsp_common.contract import LATCHED_READER_QOS, ROBOT_STATES_TOPIC
 from fjsp_msgs.msg import RobotState
 from fjsp_planner.faults import FaultError, inject_fault
 
@@ -88,7 +88,7 @@ def test_helper_works_however_the_callers_node_is_spun(fjsp_fleet, spun):
     node = rclpy.create_node('user_test', context=context)
     heard = []
     node.create_subscription(RobotState, ROBOT_STATES_TOPIC,
-                             lambda msg: heard.append(time.monotonic()), ROBOT_STATES_QOS)
+                             lambda msg: heard.append(time.monotonic()), LATCHED_READER_QOS)
     executor = SingleThreadedExecutor(context=context)
     executor.add_node(node)
     thread = None

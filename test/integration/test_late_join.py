@@ -5,7 +5,7 @@ import time
 
 from rclpy.time import Time
 
-from fjsp_common.contract import ROBOT_STATES_QOS, ROBOT_STATES_TOPIC
+from fjsp_common.contract import LATCHED_READER_QOS, ROBOT_STATES_TOPIC
 from fjsp_msgs.msg import MissionStatus, RobotState
 from fjsp_planner.launcher.listener import Listener
 
@@ -57,7 +57,7 @@ def test_a_late_subscriber_gets_every_robots_state(fjsp_fleet):
         # Matched first, then given time to receive before its executor takes anything: a
         # reader that keeps fewer samples than there are robots loses all but the last.
         late.executor.remove_node(late.node)
-        late.subscribe(RobotState, ROBOT_STATES_TOPIC, ROBOT_STATES_QOS,
+        late.subscribe(RobotState, ROBOT_STATES_TOPIC, LATCHED_READER_QOS,
                        lambda msg: states.setdefault(msg.robot, msg))
         deadline = time.monotonic() + 30
         while late.node.count_publishers(ROBOT_STATES_TOPIC) < len(ROBOTS):

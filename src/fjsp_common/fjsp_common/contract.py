@@ -49,20 +49,21 @@ LATCHED_QOS = QoSProfile(
 )
 """The current plan and latest status: a node that joins late gets the last one."""
 
-ROBOT_STATE_HISTORY = 5000
-"""Robot states a reader holds until it takes them: all writers of a topic share a reader's
-history, so it must hold what a flood of forged states delivers while the reader waits for a
-core, or the robots' own states are pushed out before they are taken. As many as Fast DDS
+READER_HISTORY = 5000
+"""Messages a reader of a latched topic (the plan, robot states, the mission status) holds
+until it takes them. Each writer keeps only its latest, but all writers of a topic share a
+reader's history, so it must hold what a flood of forged messages delivers while the reader
+waits for a core, or the fleet's own are pushed out before they are taken. As many as Fast DDS
 keeps for a reader (its default `max_samples`, which rclpy cannot raise): a deeper history
 holds no more."""
 
-ROBOT_STATES_QOS = QoSProfile(
+LATCHED_READER_QOS = QoSProfile(
     reliability=ReliabilityPolicy.RELIABLE,
     durability=DurabilityPolicy.TRANSIENT_LOCAL,
     history=HistoryPolicy.KEEP_LAST,
-    depth=ROBOT_STATE_HISTORY,
+    depth=READER_HISTORY,
 )
-"""Each agent is one writer keeping its latest state; a reader must hold at least one per
+"""How latched topics are read. A reader of robot states must also hold at least one per
 robot, or a late joiner would get a single robot's state, and a burst (a failure followed at
 once by a recovery) could lose the failure before the reader's executor takes it."""
 
@@ -96,12 +97,13 @@ class Topic:
     writer_qos: QoSProfile | None = None
 
 
-PLAN = Topic(PLAN_TOPIC, Plan, LATCHED_QOS)
-ROBOT_STATES = Topic(ROBOT_STATES_TOPIC, RobotState, ROBOT_STATES_QOS, writer_qos=LATCHED_QOS)
+PLAN = Topic(PLAN_TOPIC, Plan, LATCHED_READER_QOS, writer_qos=LATCHED_QOS)
+ROBOT_STATES = Topic(ROBOT_STATES_TOPIC, RobotState, LATCHED_READER_QOS, writer_qos=LATCHED_QOS)
 """Each agent's writer keeps only its latest state; readers keep one per robot."""
 TASK_EVENTS = Topic(TASK_EVENTS_TOPIC, TaskEvent, EVENTS_QOS)
 MISSION_EVENTS = Topic(MISSION_EVENTS_TOPIC, MissionEvent, EVENTS_QOS)
-MISSION_STATUS = Topic(MISSION_STATUS_TOPIC, MissionStatus, LATCHED_QOS)
+MISSION_STATUS = Topic(MISSION_STATUS_TOPIC, MissionStatus, LATCHED_READER_QOS,
+                       writer_qos=LATCHED_QOS)
 JOB_STATES = Topic(JOB_STATES_TOPIC, JobStates, LATCHED_QOS)
 DIAGNOSTICS = Topic(DIAGNOSTICS_TOPIC, DiagnosticArray, DIAGNOSTICS_QOS)
 ROBOT_POSES = Topic(ROBOT_POSES_TOPIC, PoseArray, LATCHED_QOS)
@@ -140,27 +142,49 @@ def subscription(node, topic: Topic, callback, auth=None, **options):
     (`NodeAuth.screen`): decoding is most of what a flood of unsigned messages costs."""
     if auth is not None and auth.enabled and not options.get('raw') \
             and 'auth' in topic.type.get_fields_and_field_types():
-        callback = _screened(topic, callback, auth)
+        callback = screening(auth, topic.name, topic.type, callback,
+                             lambda: auth.unreadable(topic.name))
         options['raw'] = True
+    return draining(node, topic.type, topic.name, topic.qos, callback, **options)
+
+
+def screened_subscription(node, msg_type, name: str, qos, callback, verifier=None):
+    """A draining subscription (see `subscription`) for a process that checks messages with a
+    `Verifier` of its own rather than a node's `NodeAuth` (the launcher, tools, tests): with
+    the fleet key, what cannot carry a signature is dropped from its bytes
+    (`Verifier.screen`); `callback` checks the rest."""
+    if verifier is None or verifier.key is None \
+            or 'auth' not in msg_type.get_fields_and_field_types():
+        return draining(node, msg_type, name, qos, callback)
+    callback = screening(verifier, node.resolve_topic_name(name), msg_type, callback)
+    return draining(node, msg_type, name, qos, callback, raw=True)
+
+
+def draining(node, msg_type, name: str, qos, callback, **options):
+    """A subscription whose callback, once the executor hands it a message, also takes every
+    message waiting behind it (up to DRAIN)."""
     taking = []
 
     def take_all(msg) -> None:
         callback(msg)
         take_waiting(taking[0], callback)
 
-    sub = node.create_subscription(topic.type, topic.name, take_all, topic.qos, **options)
+    sub = node.create_subscription(msg_type, name, take_all, qos, **options)
     taking.append(sub)
     return sub
 
 
-def _screened(topic: Topic, callback, auth):
+def screening(screener, name: str, msg_type, callback, unreadable=lambda: None):
+    """`callback` for raw messages: those `screener.screen(data, name)` refuses are dropped
+    from their bytes, the others decoded for it (`unreadable()` for bytes rclpy cannot
+    read)."""
     def screen(data: bytes) -> None:
-        if not auth.screen(data, topic.name):
+        if not screener.screen(data, name):
             return
         try:
-            msg = deserialize_message(data, topic.type)
+            msg = deserialize_message(data, msg_type)
         except Exception:  # noqa: BLE001  bytes rclpy cannot read, whatever it raises
-            auth.unreadable(topic.name)
+            unreadable()
             return
         callback(msg)
     return screen

@@ -161,9 +161,10 @@ class MissionClient:
         from fjsp_common.contract import (
             ADD_JOBS_SERVICE,
             CANCEL_MISSION_SERVICE,
-            LATCHED_QOS,
+            MISSION_STATUS,
             MISSION_STATUS_TOPIC,
             RUN_MISSION_ACTION,
+            screened_subscription,
         )
         from fjsp_msgs.action import RunMission
         from fjsp_msgs.msg import MissionStatus
@@ -190,8 +191,8 @@ class MissionClient:
         self._status_topic = self._node.resolve_topic_name(MISSION_STATUS_TOPIC)
         self.statuses_dropped: Counter[str] = Counter()
         """Mission statuses that do not verify with the fleet key, by reason: never shown."""
-        self._node.create_subscription(MissionStatus, MISSION_STATUS_TOPIC, self._on_status,
-                                       LATCHED_QOS)
+        screened_subscription(self._node, MissionStatus, MISSION_STATUS_TOPIC,
+                              MISSION_STATUS.qos, self._on_status, self._verifier)
         self._executor = SingleThreadedExecutor(context=self._context)
         self._executor.add_node(self._node)
         self._thread = threading.Thread(target=self._spin, daemon=True)

@@ -37,7 +37,6 @@ from collections import Counter, defaultdict
 from fractions import Fraction
 
 import pytest
-from rclpy.serialization import deserialize_message
 
 from fjsp_common.auth import Verifier, read_key
 from fjsp_common.clock import ScheduleClock, seconds
@@ -177,20 +176,8 @@ class Observer(Listener):
                                 (ROBOT_STATES, self._robot)):
             self.subscribe(topic.type, topic.name, topic.qos, callback)
 
-    def subscribe(self, msg_type, topic: str, qos, callback):
-        if self._verifier is None:
-            return super().subscribe(msg_type, topic, qos, callback)
-        resolved = self.node.resolve_topic_name(topic)
-
-        def screened(data: bytes) -> None:
-            if not self._verifier.screen(data, resolved):
-                return
-            try:
-                msg = deserialize_message(data, msg_type)
-            except Exception:  # noqa: BLE001  bytes rclpy cannot read, whatever it raises
-                return
-            callback(msg)
-        return super().subscribe(msg_type, topic, qos, screened, raw=True)
+    def subscribe(self, msg_type, topic: str, qos, callback, verifier=None):
+        return super().subscribe(msg_type, topic, qos, callback, verifier or self._verifier)
 
     def _robot(self, msg: RobotState) -> None:
         self.robots[msg.robot] = msg

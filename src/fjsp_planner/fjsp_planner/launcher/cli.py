@@ -147,7 +147,8 @@ def run(args: argparse.Namespace) -> int:
     def receive(msg):
         if warning := statuses.receive(msg):
             print(f'fleet: {warning}', file=sys.stderr, flush=True)
-    watch.subscribe(MISSION_STATUS.type, MISSION_STATUS.name, MISSION_STATUS.qos, receive)
+    watch.subscribe(MISSION_STATUS.type, MISSION_STATUS.name, MISSION_STATUS.qos, receive,
+                    statuses.verifier)
     supervisor = Supervisor(None if args.no_respawn else POLICY, essential={PLANNER_NODE},
                             may_finish={MONITOR_NODE} if args.exit_on_complete else ())
     ended: list[int] = []

@@ -10,6 +10,8 @@ from contextlib import contextmanager
 import rclpy
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 
+from fjsp_common.contract import screened_subscription
+
 
 class Listener:
     """A node in a private rclpy context on one domain, spun on a thread of its own: its owner
@@ -48,12 +50,14 @@ class Listener:
             if self.context.ok():
                 raise
 
-    def subscribe(self, msg_type, topic: str, qos, callback, raw: bool = False):
+    def subscribe(self, msg_type, topic: str, qos, callback, verifier=None):
+        """Every message waiting is taken in a row; with a keyed `verifier`, those that cannot
+        carry a signature are dropped from their bytes (`screened_subscription`)."""
         def locked(msg):
             with self.lock:
                 callback(msg)
                 self.lock.notify_all()
-        return self.node.create_subscription(msg_type, topic, locked, qos, raw=raw)
+        return screened_subscription(self.node, msg_type, topic, qos, locked, verifier)
 
     def wait_for(self, predicate, timeout: float) -> bool:
         """Wait until `predicate()` holds (checked under the lock at every message); whether

@@ -54,8 +54,9 @@ class MissionWatch:
     def tally(self) -> str:
         """What was dropped, in one line ('' if nothing)."""
         parts = []
-        if self.dropped['unverified']:
-            parts.append(f"{self.dropped['unverified']} that did not verify with the fleet key")
+        # The verifier counts those dropped from their bytes too (`Verifier.screen`).
+        if self.verifier.rejected:
+            parts.append(f'{self.verifier.rejected} that did not verify with the fleet key')
         if self.dropped[OTHER_MISSION]:
             parts.append(f'{self.dropped[OTHER_MISSION]} of another mission')
         return f"mission statuses dropped: {', '.join(parts)}" if parts else ''
