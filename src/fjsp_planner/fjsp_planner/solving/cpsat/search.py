@@ -17,6 +17,8 @@ KEEP_SHARE = 0.3
 """At most this share of the time limit goes, once the makespan is proven, to keeping
 previous assignments; an unproven makespan gets the whole limit."""
 MIN_SOLVE_SECONDS = 0.01
+SEARCH_WITHOUT_RELAXATION = 'no_lp'
+"""CP-SAT's full search without its linear relaxation (`solve_cpsat(relaxation=False)`)."""
 
 
 class SearchHandle:
@@ -47,7 +49,7 @@ class SearchHandle:
 def solve_cpsat(problem: Problem, time_limit=10.0, workers=2, hint: Schedule | None = None,
                 keep: Schedule | None = None, upper_bound: Schedule | None = None,
                 log=False, handle: SearchHandle | None = None,
-                lower_bound: Fraction | None = None) -> Result:
+                lower_bound: Fraction | None = None, relaxation: bool = True) -> Result:
     """Minimise the makespan; with `keep`, then prefer `keep`'s (job, robot) assignments.
 
     `upper_bound` is a valid schedule (e.g. greedy) that sets the horizon and, on models with
@@ -55,6 +57,8 @@ def solve_cpsat(problem: Problem, time_limit=10.0, workers=2, hint: Schedule | N
     the search stop as soon as it reaches it. The whole call, model building
     included, ends within `time_limit` seconds (plus CP-SAT's reaction time to its limit).
     `handle` lets another thread see the best makespan so far and stop the search early.
+    Without `relaxation`, CP-SAT's full search (with at most two workers, its only one)
+    leaves out the linear relaxation.
     """
     began = time.monotonic()
     deadline = began + time_limit
@@ -73,8 +77,8 @@ def solve_cpsat(problem: Problem, time_limit=10.0, workers=2, hint: Schedule | N
     model.minimize_makespan()
     setup = time.monotonic() - began
     solver, recorder, status = run(model.model, deadline - time.monotonic(), workers, log,
-                                   handle=handle,
-                                   scale=model.grid.scale, reader=model.read)
+                                   handle=handle, scale=model.grid.scale, reader=model.read,
+                                   relaxation=relaxation)
     if status == 'INFEASIBLE':
         return Result(Status.INFEASIBLE, None, None, time.monotonic() - began, None, 'cpsat',
                       notes=model.notes)
@@ -105,7 +109,7 @@ def _since_call(solver_seconds, setup):
     return None if solver_seconds is None else setup + solver_seconds
 
 
-def run(model, time_limit, workers, log, handle=None, scale=1, reader=None):
+def run(model, time_limit, workers, log, handle=None, scale=1, reader=None, relaxation=True):
     solver = cp_model.CpSolver()
     solver.parameters.max_time_in_seconds = max(MIN_SOLVE_SECONDS, time_limit)
     solver.parameters.num_workers = workers
@@ -116,6 +120,12 @@ def run(model, time_limit, workers, log, handle=None, scale=1, reader=None):
     # Presolve probing took the whole budget on many panels before any search, and slowed
     # the one-panel proof, without tightening the bound.
     solver.parameters.cp_model_probing_level = 0
+    if not relaxation and workers <= 2:
+        # With two workers CP-SAT runs one full search (the other interleaves neighbourhood
+        # searches), which by default solves the linear relaxation at every node. On small
+        # routed scenarios that relaxation stays near the critical path whatever it cuts, so
+        # the proof comes from the search alone, and it comes sooner without the LP.
+        solver.parameters.subsolvers.append(SEARCH_WITHOUT_RELAXATION)
     recorder = _SolutionTimes(handle, scale, reader)
     if handle is not None and not handle.attach(solver):
         solver.parameters.max_time_in_seconds = MIN_SOLVE_SECONDS
