@@ -97,12 +97,15 @@ def _backend(problem, solver, start, began, time_limit, workers, keep, mip_backe
     # the end of the limit, and only when CP-SAT has not proven its schedule optimal by then:
     # small scenarios are often proven in less. The robots' routes would delay CP-SAT's
     # start by about a second, for a floor still below the optimum. The search goes without
-    # CP-SAT's linear relaxation: it proves these scenarios sooner.
+    # CP-SAT's linear relaxation, and with the travel between every two jobs of a robot:
+    # both prove these scenarios sooner. That travel is quadratic in the jobs: a large
+    # scenario comes here only when no start was found, and then needs its time to search.
     bound = fleet_load_bound(problem, routed.LOAD_BOUND_SHARE * time_limit, routes=False)
     result = run_from(
         problem, start, began, (1 - routed.CHAIN_BOUND_SHARE) * time_limit,
         lambda left: solve_cpsat(problem, left, workers, hint=start.hint, upper_bound=start.best,
-                                 log=log, lower_bound=bound, relaxation=False))
+                                 log=log, lower_bound=bound, relaxation=False,
+                                 pairwise_travel=len(problem.jobs) <= routed.MIN_JOBS))
     if result.status == Status.OPTIMAL or result.schedule is None:
         return result
     chains = chain_bound(problem, began + time_limit - time.monotonic(), result.makespan)

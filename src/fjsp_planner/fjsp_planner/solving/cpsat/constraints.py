@@ -10,7 +10,7 @@ from fractions import Fraction
 
 from fjsp_planner.model.problem import Problem
 from fjsp_planner.solving.bounds import panel as bounds
-from fjsp_planner.solving.bounds.geometry import crossing_cost
+from fjsp_planner.solving.bounds.geometry import crossing_cost, least_job_travel
 from fjsp_planner.solving.cpsat.grid import TimeGrid
 from fjsp_planner.solving.cpsat.variables import JobVariables, RouteVariables, check
 
@@ -66,6 +66,42 @@ def routes(m, problem: Problem, grid: TimeGrid, jobs: JobVariables, route: Route
             leg = grid.ticks(legs[r, problem.job(a).location, problem.job(b).location])
             m.add(jobs.start[b] >= jobs.end[a] + leg).only_enforce_if(arc)
         m.add_circuit(arcs)
+
+
+def travel_between_jobs(m, problem: Problem, grid: TimeGrid, jobs: JobVariables,
+                        route: RouteVariables, deadline=None, clock=None):
+    """A robot doing two jobs at different places travels between them, whatever it does in
+    between: the later starts at least the least travel time along the distance table after
+    the earlier ends (the order left open unless precedence fixes it).
+
+    Implied by the routes, which state it only for consecutive jobs once the arcs are
+    chosen: stated for every pair, it moves the starts as soon as the robots are, so the
+    search prunes staffings whose travel cannot fit (the proof of small scenarios, see
+    docs/solver.md). Quadratic in each robot's jobs; running jobs are left out.
+
+    Returns (a, b, robot) -> the literal "a comes before b", for hints."""
+    orders = {}
+    ancestors = problem.ancestors()
+    for robot in problem.robots:
+        r = robot.name
+        mine = [j for j in route.nodes[r] if j not in problem.fixed]
+        for i, a in enumerate(mine):
+            check(deadline, clock)
+            for b in mine[i + 1:]:
+                if problem.job(a).location == problem.job(b).location:
+                    continue
+                both = [jobs.on_job[a, r], jobs.on_job[b, r]]
+                after_a = jobs.end[a] + grid.ticks(least_job_travel(problem, r, a, b))
+                after_b = jobs.end[b] + grid.ticks(least_job_travel(problem, r, b, a))
+                if a in ancestors[b]:
+                    m.add(jobs.start[b] >= after_a).only_enforce_if(both)
+                elif b in ancestors[a]:
+                    m.add(jobs.start[a] >= after_b).only_enforce_if(both)
+                else:
+                    a_first = orders[a, b, r] = m.new_bool_var(f'before_{a}_{b}_{r}')
+                    m.add(jobs.start[b] >= after_a).only_enforce_if(both + [a_first])
+                    m.add(jobs.start[a] >= after_b).only_enforce_if(both + [~a_first])
+    return orders
 
 
 def holding(m, problem: Problem, jobs: JobVariables, route: RouteVariables):

@@ -22,11 +22,13 @@ from fjsp_planner.solving.cpsat.variables import JobVariables, RouteVariables, c
 
 class CpsatModel:
     def __init__(self, problem: Problem, upper_bound: Schedule | None, deadline=None,
-                 delay: Fraction = Fraction(0)):
+                 delay: Fraction = Fraction(0), pairwise_travel: bool = False):
         """`upper_bound` is a valid schedule: its makespan bounds the horizon and the panel
         cuts. Without one, the horizon is that of doing the jobs one after another, `delay`
-        later (for a caller that holds jobs back until then). Building past `deadline`
-        (time.monotonic()) raises `OutOfTimeError`."""
+        later (for a caller that holds jobs back until then). `pairwise_travel` adds the
+        travel between every two jobs of a robot (`constraints.travel_between_jobs`; small
+        scenarios: it is quadratic). Building past `deadline` (time.monotonic()) raises
+        `OutOfTimeError`."""
         from fjsp_planner.solving.greedy import serial_upper_bound
 
         clock = time.monotonic
@@ -51,6 +53,9 @@ class CpsatModel:
         constraints.precedence(m, p, self.jobs)
         constraints.routes(m, p, grid, self.jobs, self.routes, self.legs, deadline, clock)
         constraints.holding(m, p, self.jobs, self.routes)
+        self.orders = (constraints.travel_between_jobs(m, p, grid, self.jobs, self.routes,
+                                                       deadline, clock)
+                       if pairwise_travel and routed else {})
         self.makespan = objective.makespan(m, self.jobs, self.horizon)
         self.places_visited = constraints.makespan_covers_work(m, p, grid, self.jobs,
                                                                self.makespan, self.legs)
@@ -90,14 +95,14 @@ class CpsatModel:
         for (a, b, owner), arc in self.routes.arcs.items():
             arcs_of.setdefault(owner, []).append((a, b, arc))
         schedule = self._respecting_symmetry(schedule)
-        ends = {}
+        ends, hinted_start = {}, {}
         for name, a in schedule.jobs.items():
             if name not in v.start or a.plan >= len(p.job(name).plans):
                 continue
             if name in p.fixed:
                 ends[name] = grid.ticks(p.fixed[name].end)
                 continue
-            start = grid.ticks(a.start)
+            start = hinted_start[name] = grid.ticks(a.start)
             robots = {r: q for r, q in a.robots.items() if (name, r) in v.does}
             longest = max((grid.ticks(p.duration(r, q)) for r, q in robots.items()
                            if p.duration(r, q) is not None), default=0)
@@ -135,6 +140,9 @@ class CpsatModel:
                     stays, stays[1:], strict=False)))
             for a, b, arc in arcs_of.get(r, ()):
                 m.add_hint(arc, int(successor.get(a) == b))
+        for (a, b, _), a_first in self.orders.items():
+            check(deadline, time.monotonic)
+            m.add_hint(a_first, int(hinted_start.get(a, 0) <= hinted_start.get(b, 0)))
         if len(ends) == len(v.start):
             m.add_hint(self.makespan, max(ends.values(), default=0))
 

@@ -49,7 +49,8 @@ class SearchHandle:
 def solve_cpsat(problem: Problem, time_limit=10.0, workers=2, hint: Schedule | None = None,
                 keep: Schedule | None = None, upper_bound: Schedule | None = None,
                 log=False, handle: SearchHandle | None = None,
-                lower_bound: Fraction | None = None, relaxation: bool = True) -> Result:
+                lower_bound: Fraction | None = None, relaxation: bool = True,
+                pairwise_travel: bool = False) -> Result:
     """Minimise the makespan; with `keep`, then prefer `keep`'s (job, robot) assignments.
 
     `upper_bound` is a valid schedule (e.g. greedy) that sets the horizon and, on models with
@@ -58,12 +59,13 @@ def solve_cpsat(problem: Problem, time_limit=10.0, workers=2, hint: Schedule | N
     included, ends within `time_limit` seconds (plus CP-SAT's reaction time to its limit).
     `handle` lets another thread see the best makespan so far and stop the search early.
     Without `relaxation`, CP-SAT's full search (with at most two workers, its only one)
-    leaves out the linear relaxation.
+    leaves out the linear relaxation; `pairwise_travel` adds the travel between every two
+    jobs of a robot to the model (`CpsatModel`).
     """
     began = time.monotonic()
     deadline = began + time_limit
     try:
-        model = CpsatModel(problem, upper_bound, deadline)
+        model = CpsatModel(problem, upper_bound, deadline, pairwise_travel=pairwise_travel)
         # Without routes (classic FJSP) CP-SAT finds better schedules from scratch than from
         # the greedy one, which then only sets the horizon.
         start = hint if hint is not None or not model.routes.routed else upper_bound
