@@ -58,7 +58,9 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     if args.fragment_of is not None and not args.check:
         parser.error('--fragment-of goes with --check')
-    return _in_worker(lambda: _check(args) if args.check else _plan(args))
+    if args.check:
+        return _in_worker(lambda: _check(args), 'checking')
+    return _in_worker(lambda: _plan(args), 'loading the scenario')
 
 
 def _interrupted(signum, frame):
@@ -70,8 +72,10 @@ def _interrupted(signum, frame):
     os._exit(128 + signum)
 
 
-def _in_worker(work) -> int:
-    """`work()`'s exit code, computed on a worker thread while this one waits for it."""
+def _in_worker(work, stage: str) -> int:
+    """`work()`'s exit code, computed on a worker thread while this one waits for it. The
+    worker is at `stage` from the moment it exists, before it first runs."""
+    global _stage
     outcome = {}
 
     def run():
@@ -81,6 +85,7 @@ def _in_worker(work) -> int:
             outcome['error'] = error
 
     worker = threading.Thread(target=run, name='fjsp-solve', daemon=True)
+    _stage = stage
     worker.start()
     # In short waits: a signal the kernel hands to another thread (a worker, a CP-SAT thread)
     # only flags the main thread, which runs the handler at its next bytecode; blocked in a
@@ -96,7 +101,6 @@ def _plan(args) -> int:
     global _stage
     from fjsp_planner.solving.solve import solve
 
-    _stage = 'loading the scenario'
     try:
         problem = _load(args)
     except ProblemError as error:
@@ -133,8 +137,6 @@ def _plan(args) -> int:
 
 def _check(args) -> int:
     """Read the scenario (or the fragment against its scenario) and say what is wrong."""
-    global _stage
-    _stage = 'checking'
     from fjsp_planner.model.extension import extend
     from fjsp_planner.model.limits import read_input_file
     from fjsp_planner.model.scenario import load_scenario
