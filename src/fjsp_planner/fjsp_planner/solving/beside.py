@@ -34,11 +34,14 @@ class Beside:
 
 
 class CpsatBeside(Beside):
-    """`solve_cpsat` in a thread of its own until `deadline`, followed by a `SearchHandle`."""
+    """`solve_cpsat` in a thread of its own until `deadline`, followed by a `SearchHandle`;
+    `relaxation` and `pairwise_travel` as `solve_cpsat` takes them."""
 
-    def __init__(self, problem, deadline, workers, upper_bound, hint, log):
+    def __init__(self, problem, deadline, workers, upper_bound, hint, log, relaxation=True,
+                 pairwise_travel=False):
         self.handle = SearchHandle()
         self.started = time.monotonic()
         super().__init__('cpsat', lambda: solve_cpsat(
             problem, max(0.05, deadline - time.monotonic()), workers, hint=hint,
-            upper_bound=upper_bound, log=log, handle=self.handle))
+            upper_bound=upper_bound, log=log, handle=self.handle, relaxation=relaxation,
+            pairwise_travel=pairwise_travel))

@@ -2,11 +2,12 @@
 search side by side, from the start (docs/solver.md, "Local search").
 
 CP-SAT runs in a thread of its own from the start's schedule, for its bound and its own
-improvements; the local search (`local`) runs meanwhile from the same schedule, and the
-fleet load and chain bounds (`bounds.assignment`, `bounds.chains`) one after the other in a
-thread of their own, each briefly (the first for a fixed amount of CP-SAT's work, the second
-for a share of the limit). The shorter schedule wins; the bound is the best of CP-SAT's, the
-static bound and those two.
+improvements (up to MAX_PAIRWISE_JOBS jobs without its linear relaxation and with the travel
+between every two jobs of a robot, which prove such scenarios sooner); the local search
+(`local`) runs meanwhile from the same schedule, and the fleet load and chain bounds
+(`bounds.assignment`, `bounds.chains`) one after the other in a thread of their own, each
+briefly (the first for a fixed amount of CP-SAT's work, the second for a share of the limit).
+The shorter schedule wins; the bound is the best of CP-SAT's, the static bound and those two.
 """
 
 import time
@@ -23,6 +24,9 @@ from fjsp_planner.solving.start import Start
 
 MIN_JOBS = 25
 """Up to this many jobs CP-SAT usually proves the optimum in seconds with both cores."""
+MAX_PAIRWISE_JOBS = 40
+"""Up to this many jobs CP-SAT beside the local search goes without its linear relaxation and
+with the travel between every two jobs of a robot, which is quadratic in the jobs."""
 LOAD_BOUND_SHARE = 0.05
 """Share of the time limit for the fleet load bound when it runs before CP-SAT (small
 scenarios, `solve`)."""
@@ -64,7 +68,9 @@ def solve_routed(problem: Problem, start: Start, began: float, time_limit: float
     deadline = began + time_limit
     first = start.best
     setup = time.monotonic() - began
-    search = CpsatBeside(problem, deadline, workers, first, start.hint or first, log)
+    small = len(problem.jobs) <= MAX_PAIRWISE_JOBS
+    search = CpsatBeside(problem, deadline, workers, first, start.hint or first, log,
+                         relaxation=not small, pairwise_travel=small)
     load = Beside('fleet load and chain bounds', lambda: search_free_bound(
         problem, time_limit, first.makespan))
     best, best_at = local_search(problem, first, deadline, stop=search.done)
