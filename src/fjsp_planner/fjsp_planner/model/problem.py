@@ -364,20 +364,12 @@ def holding_deadlocks(p: Problem) -> list[str]:
     order, it would start one held job before the first job that job waits for. Arcs into or
     out of fixed jobs are left out: their holders are given."""
     arcs = [(a, b, q) for a, b, q in p.holding if a not in p.fixed and b not in p.fixed]
-    successors: dict[str, set[str]] = {j.name: set() for j in p.jobs}
-    for a, b in list(p.precedence) + [(a, b) for a, b, _ in p.holding]:
-        successors[a].add(b)
-    after: dict[str, set[str]] = {}
-    for a, _, _ in arcs:
-        seen, todo = set(), [a]
-        while todo:
-            for nxt in successors[todo.pop()] - seen:
-                seen.add(nxt)
-                todo.append(nxt)
-        after[a] = seen
+    if len(arcs) < 2:
+        return []
+    before = p.ancestors()
     problems = []
     for (a, b, q), (c, d, r) in itertools.combinations(arcs, 2):
-        if not (d in after[a] and b in after[c]):
+        if not (a in before[d] and c in before[b]):
             continue
         able = {robot.name for robot in p.robots
                 if p.duration(robot.name, q) is not None or p.duration(robot.name, r) is not None}
