@@ -18,10 +18,12 @@ else
   # namespaces run in a process of their own, before the others: beside them, the load
   # delays heartbeats over a restored link enough to drop its robot again.
   pytest test/integration/test_network_links.py --durations=5 || status=$?
-  # The rest on FJSP_TEST_WORKERS processes (pytest-xdist), a file per process at a time:
-  # integration tests mostly wait on their time scales, so three share two cores.
+  # The rest on FJSP_TEST_WORKERS processes (pytest-xdist), a file per process at a time,
+  # the longest files first (test/conftest.py): integration tests mostly wait on their time
+  # scales, so three share two cores.
   pytest test/ --ignore=test/integration/test_network_links.py \
-    -n "${FJSP_TEST_WORKERS:-3}" --dist loadfile --durations=15 || status=$?
+    -n "${FJSP_TEST_WORKERS:-3}" --dist loadfile --no-loadscope-reorder --durations=15 \
+    || status=$?
 fi
 # pytest exits 5 when it collected nothing: for this suite that is a failure too.
 if [[ $status -eq 5 ]]; then

@@ -29,17 +29,20 @@ def pytest_report_header(config):
 
 
 LONGEST_FIRST = (
-    'solving/test_known_optima.py', 'integration/test_soak.py',
-    'integration/test_mission_service.py', 'integration/test_robot_drivers.py',
-    'integration/test_ros2_front_end.py', 'solving/bounds/test_bounds.py',
-    'integration/test_missions.py', 'integration/test_failure_modes.py',
-    'integration/test_generated_fleets.py', 'integration/test_restarts.py',
-    'integration/test_fleet_respawn.py', 'integration/test_observe.py',
-    'integration/test_fleet_cli.py', 'test_cli.py',
+    'solving/test_known_optima.py', 'integration/test_mission_service.py',
+    'integration/test_robot_drivers.py', 'integration/test_missions.py', 'test_cli.py',
+    'solving/bounds/test_bounds.py', 'integration/test_fleet_cli.py',
+    'integration/test_failure_modes.py', 'integration/test_ros2_front_end.py',
+    'integration/test_generated_fleets.py', 'integration/test_soak.py',
+    'integration/test_flood.py', 'integration/test_fleet_respawn.py',
+    'integration/test_restarts.py', 'integration/test_faults.py',
+    'integration/test_observe_browser.py', 'integration/test_observe.py',
+    'integration/test_scenarios.py', 'solving/test_large.py', 'integration/test_late_join.py',
 )
-"""The files that take longest in a whole run. pytest-xdist hands out whole files in the
-order collected: these go first, so that no long file starts last while the other processes
-run out of work."""
+"""The files that take longest in a whole run, longest first. With `--dist loadfile
+--no-loadscope-reorder` pytest-xdist hands out whole files in the order collected: these go
+first, so that no long file starts last while the other processes run out of work (by
+default it would hand out the files with the most tests first, and these last)."""
 
 
 @pytest.hookimpl(tryfirst=True)
