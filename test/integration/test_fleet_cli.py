@@ -148,8 +148,11 @@ def test_a_flood_of_forged_statuses_does_not_hide_the_real_end(tmp_path, ros_dom
                ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
     flood = flooder.start(40, 'mission_status', ['a'] * 4, env)
     try:
+        # Without the recorder and the live page, which this test does not look at and which
+        # would spend the two cores decoding the flood too.
         process = launcher(tmp_path, str(PAPER), '--exit-on-complete', '--time-scale', '0.1',
-                           '--timeout', '90', domain=ros_domain)
+                           '--timeout', '90', '--no-recording', '--web-port', '0',
+                           domain=ros_domain)
         out, err = process.communicate(timeout=150)
     finally:
         flood.kill()
