@@ -62,7 +62,17 @@ def test_every_known_optimum_is_proven_again_by_each_of_its_provers(name):
         assert validate(problem, result.schedule) == [], prover
 
 
-@pytest.mark.parametrize('name', list(KNOWN))
+SEARCHED_PANELS = 3
+"""From this many panels the panel bounds search for seconds: those entries' checks are slow."""
+
+
+def bound_checks():
+    for name, entry in KNOWN.items():
+        slow = len(entry.problem().panels) >= SEARCHED_PANELS
+        yield pytest.param(name, marks=[pytest.mark.slow] if slow else [])
+
+
+@pytest.mark.parametrize('name', list(bound_checks()))
 def test_every_bound_stays_at_or_below_the_known_optimum(name):
     """The static, fleet load and chain bounds on every entry; on panels, the panel bounds too,
     given a schedule just above the optimum (as the search would report one)."""
