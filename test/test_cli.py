@@ -23,6 +23,7 @@ def fjsp_solve(*args, cwd=None):
                           capture_output=True, text=True, env=env, cwd=cwd, timeout=120)
 
 
+@pytest.mark.integration
 def test_paper_instance_json_and_gantt(tmp_path):
     out, png = tmp_path / 'plan.json', tmp_path / 'plan.png'
     run = fjsp_solve(PAPER, '--time-limit', 20, '--json', out, '--gantt', png)
@@ -46,6 +47,7 @@ def test_paper_instance_json_and_gantt(tmp_path):
     assert png.read_bytes()[:8] == b'\x89PNG\r\n\x1a\n'
 
 
+@pytest.mark.integration
 def test_greedy_solver_and_panels(tmp_path):
     out = tmp_path / 'plan.json'
     run = fjsp_solve(PAPER, '--solver', 'greedy', '--panels', 2, '--shift', 30, '--json', out)
@@ -54,6 +56,7 @@ def test_greedy_solver_and_panels(tmp_path):
     assert data['status'] == 'feasible' and len(data['jobs']) == 24
 
 
+@pytest.mark.integration
 @pytest.mark.parametrize('args, message', [
     (['missing.yaml'], 'missing.yaml: no such file'),
     (['.'], '.: is a directory, not a scenario file'),
@@ -75,6 +78,7 @@ def test_bad_arguments_exit_2_with_a_message(args, message):
     assert 'Traceback' not in run.stderr
 
 
+@pytest.mark.integration
 @pytest.mark.parametrize('option', ['--json', '--gantt'])
 def test_an_output_that_cannot_be_written_exits_2(tmp_path, option):
     run = fjsp_solve(PAPER, '--solver', 'greedy', option, tmp_path / 'no' / 'such' / 'out')
@@ -82,6 +86,7 @@ def test_an_output_that_cannot_be_written_exits_2(tmp_path, option):
     assert run.stderr.startswith('fjsp-solve: cannot write ') and 'No such file' in run.stderr
 
 
+@pytest.mark.integration
 @pytest.mark.parametrize('old, new, message', [
     ('{name: MARC2, type: MARC, speed: 25}', '{name: MARC2, type: MARC, sped: 25}',
      "robot 'MARC2': unknown key 'sped'"),
@@ -105,6 +110,7 @@ def test_values_that_used_to_crash_the_solver_exit_2(tmp_path, old, new, message
     assert len(run.stderr.splitlines()) == 2, run.stderr        # the heading and the reason
 
 
+@pytest.mark.integration
 @pytest.mark.parametrize('name, content, message', [
     ('latin.yaml', b'name: caf\xe9\n', 'not UTF-8 text (byte 0xe9 at offset 9)'),
     ('big.fjs', b'1 2\n1 1 1 1e23\n', "time on machine 1: '1e23' is outside [0, 1e+06]"),
@@ -117,6 +123,7 @@ def test_unreadable_files_exit_2(tmp_path, name, content, message):
     assert message in run.stderr
 
 
+@pytest.mark.integration
 def test_invalid_scenario_lists_every_problem(tmp_path):
     bad = tmp_path / 'bad.yaml'
     bad.write_text(PAPER.read_text().replace('type: MARC, speed: 25', 'type: Rover, speed: 25')
@@ -166,6 +173,7 @@ def _signal_a_thread_other_than_the_main_one(pid, signum):
 # The main thread installs the handlers, then imports OR-Tools (which starts one thread of its
 # own), then starts the worker (3 threads): it loads the scenario (for seconds at 50 panels),
 # solves greedily, then CP-SAT adds its 2 search threads.
+@pytest.mark.integration
 @pytest.mark.skipif(not Path('/proc/self/status').exists(), reason='needs Linux /proc')
 @pytest.mark.parametrize('signum, panels, ready, stage, to_thread', [
     (signal.SIGINT, 10, _handles_sigterm, None, False),
@@ -285,12 +293,14 @@ BEAM = (DATA / 'beam_drive.yaml').read_text()
 FRAGMENT = FRAGMENTS / 'solar_panel_second_panel.yaml'
 
 
+@pytest.mark.integration
 def test_check_says_a_scenario_is_fine_and_solves_nothing():
     run = fjsp_solve('--check', PAPER)
     assert (run.returncode, run.stderr) == (0, '')
     assert run.stdout == f'{PAPER}: fine: 12 jobs, 4 robots, 12 locations\n'
 
 
+@pytest.mark.integration
 def test_check_names_every_problem(tmp_path):
     bad = tmp_path / 'bad.yaml'
     bad.write_text(BEAM.replace('type: Crane, speed', 'type: Crain, speed')
@@ -307,6 +317,7 @@ def test_check_names_every_problem(tmp_path):
         "type)"]
 
 
+@pytest.mark.integration
 def test_warnings_are_printed_and_the_plan_goes_on(tmp_path):
     """The travel type is called `drive` and nothing says so: travel is free, so said."""
     beam = tmp_path / 'beam.yaml'
@@ -321,6 +332,7 @@ def test_warnings_are_printed_and_the_plan_goes_on(tmp_path):
     assert fjsp_solve('--check', beam).stderr == ''
 
 
+@pytest.mark.integration
 def test_a_fragment_is_checked_against_its_scenario(tmp_path):
     run = fjsp_solve('--check', FRAGMENT, '--fragment-of', PAPER)
     assert (run.returncode, run.stderr) == (0, ''), run.stderr
@@ -338,6 +350,7 @@ def test_a_fragment_is_checked_against_its_scenario(tmp_path):
         "  - precedence arc ('Ad', 'Xx') names unknown job 'Xx'"]
 
 
+@pytest.mark.integration
 def test_fragment_of_goes_with_check():
     run = fjsp_solve(FRAGMENT, '--fragment-of', PAPER)
     assert run.returncode == 2 and '--fragment-of goes with --check' in run.stderr

@@ -44,6 +44,8 @@ def test_good_arguments_give_the_factor_to_send():
     assert check_fault('fail', None) == 0.0 and check_fault('recover', None) == 0.0
 
 
+@pytest.mark.integration
+@pytest.mark.integration
 @pytest.mark.parametrize(('args', 'message'), [
     ([], 'the following arguments are required: robot, fault'),
     (['MARC1', 'explode'], "invalid choice: 'explode'"),
