@@ -1,6 +1,7 @@
 """The local search for multi-robot jobs with travel: valid, never worse than its start, and
 it finds the moves a critical path asks for."""
 
+import random
 import time
 from fractions import Fraction
 
@@ -10,12 +11,11 @@ from fjsp_planner.model.scenario import parse_scenario
 from fjsp_planner.model.schedule import JobAssignment, Schedule
 from fjsp_planner.model.validate import validate
 from fjsp_planner.solving.greedy import greedy_schedule
-from fjsp_planner.solving.local import local_search
+from fjsp_planner.solving.local import _best_move, _from_schedule, _Instance, local_search
 
 
-def test_jobs_move_from_a_slow_robot_to_a_fast_one():
-    """A welds in 5, B in 1; x then y both on A end at 10. Giving y to B ends at 5, then x
-    too at 2 (B welds both, one after the other), the optimum."""
+def _slow_and_fast():
+    """A welds in 5, B in 1; the schedule doing x then y on A ends at 10."""
     problem = Problem(operation_types={1: 'weld'},
                       robot_types={'Slow': {1: Fraction(5)}, 'Fast': {1: Fraction(1)}},
                       robots=(Robot('A', 'Slow'), Robot('B', 'Fast')),
@@ -24,6 +24,13 @@ def test_jobs_move_from_a_slow_robot_to_a_fast_one():
                       'y': JobAssignment('y', 0, Fraction(5), Fraction(10), {'A': 1})},
                      {'A': ('x', 'y'), 'B': ()})
     assert validate(problem, start) == []
+    return problem, start
+
+
+def test_jobs_move_from_a_slow_robot_to_a_fast_one():
+    """Giving y to B ends at 5, then x too at 2 (B welds both, one after the other), the
+    optimum."""
+    problem, start = _slow_and_fast()
     found, _ = local_search(problem, start, time.monotonic() + 1)
     assert validate(problem, found) == []
     assert found.makespan == 2
@@ -38,3 +45,24 @@ def test_generated_scenarios_stay_valid_and_no_longer():
         found, _ = local_search(problem, start, time.monotonic() + 0.5, seed=seed)
         assert validate(problem, found) == []
         assert found.makespan <= start.makespan
+
+
+def test_a_tabu_job_moves_only_to_beat_the_best_schedule():
+    """With x and y both tabu, giving one to B (ends at 5) is still made while the best
+    schedule found ends at 10, and no move is made once one ending at 2 was found."""
+    problem, start = _slow_and_fast()
+    inst = _Instance(problem)
+    current = _from_schedule(inst, start)
+    assert current.evaluate(inst)
+    x, y = inst.index['x'], inst.index['y']
+    tabu = {x: 5, y: 5}
+    moved, job = _best_move(inst, current, random.Random(0), tabu, 1, current)
+    assert moved.makespan == 5 and job in (x, y)
+    both_fast = _from_schedule(inst, Schedule(
+        {'x': JobAssignment('x', 0, Fraction(0), Fraction(1), {'B': 1}),
+         'y': JobAssignment('y', 0, Fraction(1), Fraction(2), {'B': 1})},
+        {'A': (), 'B': ('x', 'y')}))
+    assert both_fast.evaluate(inst) and both_fast.makespan == 2
+    assert _best_move(inst, current, random.Random(0), tabu, 1, both_fast) == (None, None)
+    moved, _ = _best_move(inst, current, random.Random(0), {}, 1, both_fast)
+    assert moved.makespan == 5

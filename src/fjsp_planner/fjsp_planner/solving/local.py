@@ -12,10 +12,12 @@ it on a robot or by precedence, that ends at the makespan) and tries, for each:
   robot's route next to a job at the same place (the legs around it vanish);
 
 and makes the best move that shortens the makespan, or that keeps it and shortens the sum
-of job ends (which frees robots earlier); with none, it shakes the best schedule by a few
-random moves. Jobs of holding arcs keep their holders and their order (the holders go
-directly from one to the other); running (fixed) jobs are never moved. A move whose orders
-and precedence close a cycle is refused.
+of job ends (which frees robots earlier), or else the least bad one; a job moved is left
+where it is for some steps (tabu) unless moving it beats the best schedule, so the search
+walks on past a local optimum instead of undoing its last move. After some steps without a
+better schedule it shakes the best one by a few random moves. Jobs of holding arcs keep
+their holders and their order (the holders go directly from one to the other); running
+(fixed) jobs are never moved. A move whose orders and precedence close a cycle is refused.
 """
 
 import random
@@ -29,6 +31,10 @@ from fjsp_planner.solving.compact import earliest_schedule
 STALL_STEPS = 30
 """Steps without a better schedule before the search shakes the best one."""
 SHAKE_MOVES = 3
+TABU_STEPS = (8, 20)
+"""A job moved is tabu for a random number of steps in this range: long enough that the
+search does not cycle through a few schedules, short enough that a stall of STALL_STEPS still
+ends in a shake."""
 
 
 class _Instance:
@@ -164,8 +170,12 @@ def local_search(problem: Problem, start: Schedule, deadline: float, seed: int =
     best = current
     rng = random.Random(seed)
     stalled = 0
+    tabu, step = {}, 0
     while time.monotonic() < deadline and not (stop is not None and stop()):
-        moved = _best_move(inst, current, rng)
+        step += 1
+        moved, job = _best_move(inst, current, rng, tabu, step, best)
+        if job is not None:
+            tabu[job] = step + rng.randint(*TABU_STEPS)
         if moved is None or not moved.better(current):
             stalled += 1
             if stalled >= STALL_STEPS:
@@ -211,13 +221,17 @@ def _tied(inst: _Instance, j) -> bool:
     return j in inst.fixed or j in inst.held_types
 
 
-def _best_move(inst: _Instance, current: _Solution, rng):
-    best = None
+def _best_move(inst: _Instance, current: _Solution, rng, tabu, step, record):
+    """The best solution one move from `current` around a job of its critical path, and that
+    job; a job tabu until a later step is moved only to beat `record`."""
+    best, job = None, None
     for j in current.critical():
+        banned = tabu.get(j, 0) > step
         for moved in _moves(inst, current, j, rng):
-            if moved.evaluate(inst) and (best is None or moved.better(best)):
-                best = moved
-    return best
+            if moved.evaluate(inst) and (best is None or moved.better(best)) and \
+                    (not banned or moved.better(record)):
+                best, job = moved, j
+    return best, job
 
 
 def _moves(inst: _Instance, current: _Solution, j, rng):
