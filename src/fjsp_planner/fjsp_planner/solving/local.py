@@ -61,6 +61,17 @@ class _Instance:
         self.release = {r.name: float(r.release_time) for r in p.robots}
         self.start_location = {r.name: r.start_location for r in p.robots}
         self.legs = {}
+        self.successors = [[] for _ in self.names]
+        for j, before in enumerate(self.predecessors):
+            for a in before:
+                self.successors[a].append(j)
+        places = sorted(set(self.location))
+        self.arrival = {r: [self.release[r] + self.leg(r, self.start_location[r], here)
+                            for here in self.location] for r in self.robots}
+        self.between = {r: {a: {b: self.leg(r, a, b) for b in places} for a in places}
+                        for r in self.robots}
+        self.times = {r: {q: self.time(r, q) for q in p.operation_types
+                          if self.time(r, q) is not None} for r in self.robots}
 
     def time(self, robot, q) -> float | None:
         key = (robot, q)
@@ -96,44 +107,50 @@ class _Solution:
     def evaluate(self, inst: _Instance) -> bool:
         """Earliest times; False if the orders and precedence close a cycle."""
         n = len(inst.names)
-        previous = [dict() for _ in range(n)]
-        waiting = [len(inst.predecessors[j]) for j in range(n)]
-        unblocks = [[] for _ in range(n)]
-        for j in range(n):
-            for a in inst.predecessors[j]:
-                unblocks[a].append(j)
+        previous = [None] * n
+        waiting = [len(before) for before in inst.predecessors]
+        unblocks = [list(after) for after in inst.successors]
         for r, order in self.orders.items():
             for a, b in zip(order, order[1:], strict=False):
-                previous[b][r] = a
+                if previous[b] is None:
+                    previous[b] = {r: a}
+                else:
+                    previous[b][r] = a
                 waiting[b] += 1
                 unblocks[a].append(b)
         ready = [j for j in range(n) if not waiting[j]]
         start, end, cause = [0.0] * n, [0.0] * n, [None] * n
+        location, predecessors, fixed = inst.location, inst.predecessors, inst.fixed
+        arrival, between, times, release = inst.arrival, inst.between, inst.times, inst.release
         done = 0
         while ready:
             j = ready.pop()
             done += 1
-            if j in inst.fixed:
-                start[j], end[j] = inst.fixed[j]
+            if j in fixed:
+                start[j], end[j] = fixed[j]
             else:
-                here = inst.location[j]
+                here = location[j]
                 at, by = 0.0, None
-                for a in inst.predecessors[j]:
+                for a in predecessors[j]:
                     if end[a] > at:
                         at, by = end[a], a
                 longest = 0.0
+                before_on = previous[j]
                 for r, q in self.robots[j].items():
-                    before = previous[j].get(r)
+                    before = None if before_on is None else before_on.get(r)
                     if before is None:
-                        there = inst.release[r] + inst.leg(r, inst.start_location[r], here)
+                        there = arrival[r][j]
                         if there > at:
                             at, by = there, None
                     else:
-                        there = max(end[before] + inst.leg(r, inst.location[before], here),
-                                    inst.release[r])
+                        there = end[before] + between[r][location[before]][here]
+                        if there < release[r]:
+                            there = release[r]
                         if there > at:
                             at, by = there, before
-                    longest = max(longest, inst.time(r, q))
+                    took = times[r][q]
+                    if took > longest:
+                        longest = took
                 start[j], end[j], cause[j] = at, at + longest, by
             for b in unblocks[j]:
                 waiting[b] -= 1
