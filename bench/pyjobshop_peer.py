@@ -51,7 +51,8 @@ def ensure_venv() -> Path:
 def run_peer(instance: str, time_limit: float, workers: int, panels: int = 1) -> dict:
     """Solve `instance` (scenario .yaml or .fjs) with PyJobShop; a dict of its figures.
 
-    Keys: status, makespan, bound (schedule units, None without a solution), seconds, grid.
+    Keys: status (`error: ` and the peer's last line of error when it failed), makespan,
+    bound (schedule units, None without a solution), seconds, grid.
     """
     python = ensure_venv()
     command = [str(python), __file__, '--serve', instance, '--time-limit', str(time_limit),
@@ -60,8 +61,8 @@ def run_peer(instance: str, time_limit: float, workers: int, panels: int = 1) ->
     done = subprocess.run(command, capture_output=True, text=True,
                           timeout=time_limit * 3 + 120)
     if done.returncode != 0:
-        return {'status': 'error', 'makespan': None, 'bound': None, 'seconds': None,
-                'error': done.stderr.strip().splitlines()[-1:] or ['?']}
+        reason = (done.stderr.strip().splitlines() or [f'exit status {done.returncode}'])[-1]
+        return {'status': f'error: {reason}', 'makespan': None, 'bound': None, 'seconds': None}
     return json.loads(done.stdout.strip().splitlines()[-1])
 
 
