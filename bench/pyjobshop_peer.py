@@ -98,6 +98,27 @@ def _staffings(problem, plan):
         yield dict(staffing)
 
 
+def _holders(staffing, q) -> frozenset:
+    return frozenset(r for r, t in staffing.items() if t == q)
+
+
+def _held_staffings(problem) -> dict:
+    """Every job's staffings, less those of a holding arc's first job whose q-robots staff
+    no way of doing the held job: that staffing has no schedule, and PyJobShop takes no mode
+    dependency on an empty set of modes."""
+    options = {job.name: [s for plan in job.plans for s in _staffings(problem, plan)]
+               for job in problem.jobs}
+    changed = True
+    while changed:
+        changed = False
+        for a, b, q in problem.holding:
+            held = {_holders(s, q) for s in options[b]}
+            kept = [s for s in options[a] if _holders(s, q) in held]
+            changed |= len(kept) < len(options[a])
+            options[a] = kept
+    return options
+
+
 def _serve(instance, time_limit, workers, panels):
     from pyjobshop import Model
 
@@ -112,18 +133,16 @@ def _serve(instance, time_limit, workers, panels):
     tasks, modes = {}, {}
     for job in problem.jobs:
         task = tasks[job.name] = model.add_task(name=job.name)
-        for plan in job.plans:
-            for staffing in _staffings(problem, plan):
-                duration = max(ticks(problem.duration(r, q)) for r, q in staffing.items())
-                mode = model.add_mode(task, [machines[r] for r in staffing], duration)
-                modes.setdefault(job.name, []).append((staffing, mode))
+        for staffing in _held_staffings(problem)[job.name]:
+            duration = max(ticks(problem.duration(r, q)) for r, q in staffing.items())
+            mode = model.add_mode(task, [machines[r] for r in staffing], duration)
+            modes.setdefault(job.name, []).append((staffing, mode))
     for a, b in problem.precedence:
         model.add_end_before_start(tasks[a], tasks[b])
     for a, b, q in problem.holding:
         for staffing, mode in modes[a]:
-            holders = {r for r, t in staffing.items() if t == q}
-            matching = [m for s, m in modes[b] if {r for r, t in s.items() if t == q} == holders]
-            model.add_mode_dependency(mode, matching)
+            model.add_mode_dependency(mode, [m for s, m in modes[b]
+                                             if _holders(s, q) == _holders(staffing, q)])
         model.add_consecutive(tasks[a], tasks[b])
     if problem.locomote is not None:
         for robot in problem.robots:
