@@ -57,37 +57,22 @@ class _Instance:
             for name in (a, b):
                 self.held_types.setdefault(self.index[name], set()).add(q)
         self.holding = [(self.index[a], self.index[b], q) for a, b, q in p.holding]
-        self.duration = {}
         self.release = {r.name: float(r.release_time) for r in p.robots}
-        self.start_location = {r.name: r.start_location for r in p.robots}
-        self.legs = {}
         self.successors = [[] for _ in self.names]
         for j, before in enumerate(self.predecessors):
             for a in before:
                 self.successors[a].append(j)
+        # Tabled once: timing a candidate looks them up for every job and robot.
         places = sorted(set(self.location))
-        self.arrival = {r: [self.release[r] + self.leg(r, self.start_location[r], here)
-                            for here in self.location] for r in self.robots}
-        self.between = {r: {a: {b: self.leg(r, a, b) for b in places} for a in places}
+        self.arrival = {r.name: [self.release[r.name] + self._leg(r.name, r.start_location, here)
+                                 for here in self.location] for r in p.robots}
+        self.between = {r: {a: {b: self._leg(r, a, b) for b in places} for a in places}
                         for r in self.robots}
-        self.times = {r: {q: self.time(r, q) for q in p.operation_types
-                          if self.time(r, q) is not None} for r in self.robots}
+        self.times = {r: {q: float(found) for q in p.operation_types
+                          if (found := p.duration(r, q)) is not None} for r in self.robots}
 
-    def time(self, robot, q) -> float | None:
-        key = (robot, q)
-        if key not in self.duration:
-            found = self.problem.duration(robot, q)
-            self.duration[key] = None if found is None else float(found)
-        return self.duration[key]
-
-    def leg(self, robot, a, b) -> float:
-        if a is None or a == b:
-            return 0.0
-        key = (robot, a, b)
-        found = self.legs.get(key)
-        if found is None:
-            found = self.legs[key] = float(self.problem.travel(robot, a, b))
-        return found
+    def _leg(self, robot, a, b) -> float:
+        return 0.0 if a is None else float(self.problem.travel(robot, a, b))
 
 
 class _Solution:
@@ -255,7 +240,7 @@ def _moves(inst: _Instance, current: _Solution, j, rng):
     """Solutions one move from `current` around job j (not yet evaluated)."""
     for r, q in _movable_operations(inst, current, j):
         others = [o for o in inst.robots
-                  if o not in current.robots[j] and inst.time(o, q) is not None]
+                  if o not in current.robots[j] and q in inst.times[o]]
         rng.shuffle(others)
         for other in others[:4]:
             for shift in (0, -1, 1):
