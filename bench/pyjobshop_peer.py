@@ -131,9 +131,10 @@ def _serve(instance, time_limit, workers, panels):
     model = Model()
     machines = {r.name: model.add_machine(name=r.name) for r in problem.robots}
     tasks, modes = {}, {}
+    staffings = _held_staffings(problem)
     for job in problem.jobs:
         task = tasks[job.name] = model.add_task(name=job.name)
-        for staffing in _held_staffings(problem)[job.name]:
+        for staffing in staffings[job.name]:
             duration = max(ticks(problem.duration(r, q)) for r, q in staffing.items())
             mode = model.add_mode(task, [machines[r] for r in staffing], duration)
             modes.setdefault(job.name, []).append((staffing, mode))
