@@ -9,9 +9,12 @@ it on a robot or by precedence, that ends at the makespan) and tries, for each:
 - giving one of its operations to another able robot, put into that robot's order where the
   job's current start falls (or one place earlier or later);
 - swapping it with the job before or after it on one of its robots, or moving it on that
-  robot's route next to a job at the same place (the legs around it vanish);
+  robot's route next to a job at the same place (the legs around it vanish).
 
-and makes the best move that shortens the makespan, or that keeps it and shortens the sum
+Each move is first estimated by the longest path through what it changes, from the current
+times and each job's longest way to the end (as in Mastrolilli and Gambardella's tabu
+search): a few lookups instead of timing every job. The few best estimated are timed; the
+search makes the best that shortens the makespan, or that keeps it and shortens the sum
 of job ends (which frees robots earlier), or else the least bad one; a job moved is left
 where it is for some steps (tabu) unless moving it beats the best schedule, so the search
 walks on past a local optimum instead of undoing its last move. After some steps without a
@@ -35,6 +38,9 @@ TABU_STEPS = (8, 20)
 """A job moved is tabu for a random number of steps in this range: long enough that the
 search does not cycle through a few schedules, short enough that a stall of STALL_STEPS still
 ends in a shake."""
+EXACT_MOVES = 3
+"""Moves timed per step, the best estimated: an estimate costs a few lookups, timing a move
+every job."""
 
 
 class _Instance:
@@ -57,6 +63,10 @@ class _Instance:
             for name in (a, b):
                 self.held_types.setdefault(self.index[name], set()).add(q)
         self.holding = [(self.index[a], self.index[b], q) for a, b, q in p.holding]
+        self.holds_into = {}
+        """job -> [(the job it holds into, operation type)]."""
+        for a, b, q in self.holding:
+            self.holds_into.setdefault(a, []).append((b, q))
         self.release = {r.name: float(r.release_time) for r in p.robots}
         self.successors = [[] for _ in self.names]
         for j, before in enumerate(self.predecessors):
@@ -84,6 +94,9 @@ class _Solution:
         self.makespan = self.total = None
         self.cause = None
         """job -> the job whose end set its start (None: its robots' release or arrival)."""
+        self.previous = self.timed = None
+        """job -> {robot: the job before it in the robot's order} (None: first on all), and
+        the jobs in the order they were timed (a topological order)."""
 
     def copy(self):
         return _Solution(list(self.plan), [dict(r) for r in self.robots],
@@ -105,12 +118,12 @@ class _Solution:
                 unblocks[a].append(b)
         ready = [j for j in range(n) if not waiting[j]]
         start, end, cause = [0.0] * n, [0.0] * n, [None] * n
+        timed = []
         location, predecessors, fixed = inst.location, inst.predecessors, inst.fixed
         arrival, between, times, release = inst.arrival, inst.between, inst.times, inst.release
-        done = 0
         while ready:
             j = ready.pop()
-            done += 1
+            timed.append(j)
             if j in fixed:
                 start[j], end[j] = fixed[j]
             else:
@@ -141,9 +154,10 @@ class _Solution:
                 waiting[b] -= 1
                 if not waiting[b]:
                     ready.append(b)
-        if done < n:
+        if len(timed) < n:
             return False
         self.start, self.end, self.cause = start, end, cause
+        self.previous, self.timed = previous, timed
         self.makespan, self.total = max(end, default=0.0), sum(end)
         return True
 
@@ -223,48 +237,204 @@ def _tied(inst: _Instance, j) -> bool:
     return j in inst.fixed or j in inst.held_types
 
 
+class _Around:
+    """What the estimates of moves from a solution need: each job's longest way to the
+    end (from its start, its duration included) and its next job on each robot."""
+
+    def __init__(self, inst: _Instance, solution: _Solution):
+        self.solution = solution
+        start, end = solution.start, solution.end
+        n = len(start)
+        following = [None] * n
+        for r, order in solution.orders.items():
+            for a, b in zip(order, order[1:], strict=False):
+                if following[a] is None:
+                    following[a] = {r: b}
+                else:
+                    following[a][r] = b
+        self.following = following
+        tail = [0.0] * n
+        location, between, successors = inst.location, inst.between, inst.successors
+        for j in reversed(solution.timed):
+            longest = 0.0
+            for b in successors[j]:
+                if tail[b] > longest:
+                    longest = tail[b]
+            after = following[j]
+            if after is not None:
+                here = location[j]
+                for r, b in after.items():
+                    way = between[r][here][location[b]] + tail[b]
+                    if way > longest:
+                        longest = way
+            tail[j] = end[j] - start[j] + longest
+        self.tail = tail
+
+    def inputs(self, inst, j, skip):
+        """The earliest job j can start by its predecessors and its robots but `skip`."""
+        end = self.solution.end
+        at = 0.0
+        for a in inst.predecessors[j]:
+            if end[a] > at:
+                at = end[a]
+        before_on = self.solution.previous[j]
+        for r in self.solution.robots[j]:
+            if r in skip:
+                continue
+            before = None if before_on is None else before_on.get(r)
+            there = self.reach(inst, r, before, j)
+            if there > at:
+                at = there
+        return at
+
+    def reach(self, inst, r, before, j):
+        """When robot r can be at job j coming from job `before` (None: from its start)."""
+        if before is None:
+            return inst.arrival[r][j]
+        leg = inst.between[r][inst.location[before]][inst.location[j]]
+        return max(self.solution.end[before] + leg, inst.release[r])
+
+    def outputs(self, inst, j, skip):
+        """The longest way from j's end to the end, through its successors and the next
+        jobs of its robots but `skip`."""
+        tail, location = self.tail, inst.location
+        longest = 0.0
+        for b in inst.successors[j]:
+            if tail[b] > longest:
+                longest = tail[b]
+        after = self.following[j]
+        if after is not None:
+            here = location[j]
+            for r, b in after.items():
+                if r not in skip:
+                    way = inst.between[r][here][location[b]] + tail[b]
+                    if way > longest:
+                        longest = way
+        return longest
+
+    def leave(self, inst, r, before, after):
+        """The longest path through robot r's new leg from `before` to `after` once the job
+        between them is gone."""
+        if after is None:
+            return 0.0
+        return self.reach(inst, r, before, after) + self.tail[after]
+
+    def estimate(self, inst, move) -> float:
+        """The longest path through what the move changes, in the current times."""
+        solution, location = self.solution, inst.location
+        kind = move[0]
+        if kind == 'give':
+            _, j, r, q, other, place = move
+            order = solution.orders[other]
+            before = order[place - 1] if place > 0 else None
+            after = order[place] if place < len(order) else None
+            took = inst.times[other][q]
+            for s, qs in solution.robots[j].items():
+                if s != r and inst.times[s][qs] > took:
+                    took = inst.times[s][qs]
+            at = max(self.inputs(inst, j, (r,)), self.reach(inst, other, before, j))
+            out = self.outputs(inst, j, (r,))
+            if after is not None:
+                out = max(out, inst.between[other][location[j]][location[after]]
+                          + self.tail[after])
+            old = solution.orders[r]
+            k = old.index(j)
+            gone = self.leave(inst, r, old[k - 1] if k > 0 else None,
+                              old[k + 1] if k + 1 < len(old) else None)
+            return max(at + took + out, gone)
+        if kind == 'swap':
+            _, r, k = move
+            order = solution.orders[r]
+            x, y = order[k], order[k + 1]
+            shared = [r]
+            end, tail, between = solution.end, self.tail, inst.between
+            here_x, here_y = location[x], location[y]
+            before_x = solution.previous[x] or {}
+            after_x, after_y = self.following[x] or {}, self.following[y] or {}
+            start_y = self.inputs(inst, y, shared)
+            for s in shared:
+                start_y = max(start_y, self.reach(inst, s, before_x.get(s), y))
+            end_y = start_y + end[y] - solution.start[y]
+            start_x = self.inputs(inst, x, shared)
+            out_x = self.outputs(inst, x, shared)
+            back = 0.0
+            for s in shared:
+                leg = between[s][here_y][here_x]
+                start_x = max(start_x, end_y + leg)
+                after = after_x[s]
+                if after == y:
+                    after = after_y.get(s)
+                if after is not None:
+                    out_x = max(out_x, between[s][here_x][location[after]] + tail[after])
+                back = max(back, leg)
+            tail_x = end[x] - solution.start[x] + out_x
+            tail_y = end[y] - solution.start[y] + max(self.outputs(inst, y, shared),
+                                                      back + tail_x)
+            return max(start_y + tail_y, start_x + tail_x)
+        _, r, j, m = move
+        order = solution.orders[r]
+        k = order.index(j)
+        rest = order[:k] + order[k + 1:]
+        before = rest[m - 1] if m > 0 else None
+        after = rest[m] if m < len(rest) else None
+        at = max(self.inputs(inst, j, (r,)), self.reach(inst, r, before, j))
+        out = self.outputs(inst, j, (r,))
+        if after is not None:
+            out = max(out, inst.between[r][location[j]][location[after]] + self.tail[after])
+        gone = self.leave(inst, r, order[k - 1] if k > 0 else None,
+                          order[k + 1] if k + 1 < len(order) else None)
+        return max(at + solution.end[j] - solution.start[j] + out, gone)
+
+
 def _best_move(inst: _Instance, current: _Solution, rng, tabu, step, record):
     """The best solution one move from `current` around a job of its critical path, and that
-    job; a job tabu until a later step is moved only to beat `record`."""
-    best, job = None, None
+    job; a job tabu until a later step is moved only to beat `record`. Moves are ranked by
+    an estimate; the EXACT_MOVES best of them are timed."""
+    around = _Around(inst, current)
+    ranked = []
     for j in current.critical():
-        banned = tabu.get(j, 0) > step
-        for moved in _moves(inst, current, j, rng):
-            if moved.evaluate(inst) and (best is None or moved.better(best)) and \
-                    (not banned or moved.better(record)):
-                best, job = moved, j
+        for move in _moves(inst, current, j, rng):
+            ranked.append((around.estimate(inst, move), rng.random(), j, move))
+    ranked.sort(key=lambda e: (e[0], e[1]))
+    best, job, timed = None, None, 0
+    for _, _, j, move in ranked:
+        moved = _apply(current, move)
+        if not moved.evaluate(inst):
+            continue
+        if tabu.get(j, 0) > step and not moved.better(record):
+            continue
+        timed += 1
+        if best is None or moved.better(best):
+            best, job = moved, j
+        if timed >= EXACT_MOVES:
+            break
     return best, job
 
 
 def _moves(inst: _Instance, current: _Solution, j, rng):
-    """Solutions one move from `current` around job j (not yet evaluated)."""
+    """Moves from `current` around job j: ('give', j, robot, type, other robot, place in its
+    order), ('swap', robot, k: the k-th and next job of its order), ('reinsert', robot, j,
+    place in its order without j)."""
     for r, q in _movable_operations(inst, current, j):
         others = [o for o in inst.robots
                   if o not in current.robots[j] and q in inst.times[o]]
         rng.shuffle(others)
         for other in others[:4]:
-            for shift in (0, -1, 1):
-                moved = current.copy()
-                del moved.robots[j][r]
-                moved.robots[j][other] = q
-                moved.orders[r].remove(j)
-                order = moved.orders[other]
-                place = sum(1 for k in order if current.start[k] < current.start[j]) + shift
-                if 0 <= place <= len(order):
-                    order.insert(place, j)
-                    if _holds_kept(inst, moved, other):
-                        yield moved
+            order = current.orders[other]
+            near = sum(1 for k in order if current.start[k] < current.start[j])
+            for place in (near, near - 1, near + 1):
+                if 0 <= place <= len(order) and not _splits_hold(inst, current, other,
+                                                                  order, place):
+                    yield ('give', j, r, q, other, place)
     if _tied(inst, j):
         return
     for r in current.robots[j]:
         order = current.orders[r]
         k = order.index(j)
-        for other in (k - 1, k + 1):
-            if 0 <= other < len(order) and not _tied(inst, order[other]):
-                moved = current.copy()
-                swapped = moved.orders[r]
-                swapped[k], swapped[other] = swapped[other], swapped[k]
-                yield moved
+        for first in (k - 1, k):
+            if 0 <= first and first + 1 < len(order) and \
+                    not _tied(inst, order[first if first != k else k + 1]):
+                yield ('swap', r, first)
         # Next to a job at the same place on the robot's route, the legs around it vanish.
         here = inst.location[j]
         rest = order[:k] + order[k + 1:]
@@ -273,22 +443,39 @@ def _moves(inst: _Instance, current: _Solution, j, rng):
                                  or (m < len(rest) and inst.location[rest[m]] == here))]
         rng.shuffle(places)
         for m in places[:4]:
-            moved = current.copy()
-            moved.orders[r] = rest[:m] + [j] + rest[m:]
-            if _holds_kept(inst, moved, r):
-                yield moved
+            if not _splits_hold(inst, current, r, rest, m):
+                yield ('reinsert', r, j, m)
 
 
-def _holds_kept(inst: _Instance, solution: _Solution, robot) -> bool:
-    """Whether every job the robot holds out of is still directly followed by the job it
-    holds into, in the robot's order."""
-    order = solution.orders[robot]
-    for a, b, q in inst.holding:
-        if solution.robots[a].get(robot) == q:
-            k = order.index(a)
-            if k + 1 >= len(order) or order[k + 1] != b:
-                return False
-    return True
+def _apply(current: _Solution, move) -> _Solution:
+    """The solution `move` makes of `current` (not yet evaluated)."""
+    moved = current.copy()
+    if move[0] == 'give':
+        _, j, r, q, other, place = move
+        del moved.robots[j][r]
+        moved.robots[j][other] = q
+        moved.orders[r].remove(j)
+        moved.orders[other].insert(place, j)
+    elif move[0] == 'swap':
+        _, r, k = move
+        order = moved.orders[r]
+        order[k], order[k + 1] = order[k + 1], order[k]
+    else:
+        _, r, j, m = move
+        order = moved.orders[r]
+        order.remove(j)
+        order.insert(m, j)
+    return moved
+
+
+def _splits_hold(inst: _Instance, solution: _Solution, robot, order, place) -> bool:
+    """Whether putting a job at `place` of the robot's `order` comes between a job the robot
+    holds out of and the job it holds into."""
+    if not 0 < place < len(order):
+        return False
+    a, b = order[place - 1], order[place]
+    return any(into == b and solution.robots[a].get(robot) == q
+               for into, q in inst.holds_into.get(a, ()))
 
 
 def _shaken(inst: _Instance, best: _Solution, rng) -> _Solution:
@@ -300,9 +487,9 @@ def _shaken(inst: _Instance, best: _Solution, rng) -> _Solution:
         for j in jobs[:10]:
             options = list(_moves(inst, current, j, rng))
             rng.shuffle(options)
-            moved = next((o for o in options if o.evaluate(inst)), None)
+            moved = next((m for o in options if (m := _apply(current, o)).evaluate(inst)),
+                         None)
             if moved is not None:
                 current = moved
                 break
     return current
-
