@@ -36,6 +36,27 @@ def test_jobs_move_from_a_slow_robot_to_a_fast_one():
     assert found.makespan == 2
 
 
+def test_two_jobs_of_the_same_robots_change_places():
+    """x and y each need both A and B (x 5 long, y 1), z needs C after y. Done x then y, z
+    ends at 11; y then x lets z start at 1 and everything ends at 6, the optimum. Swapped
+    on A alone, x and y would follow each other in both orders (B still does x first)."""
+    problem = Problem(operation_types={1: 'weld', 2: 'bolt', 3: 'inspect'},
+                      robot_types={'Arm': {1: Fraction(5), 2: Fraction(1)},
+                                   'Eye': {3: Fraction(5)}},
+                      robots=(Robot('A', 'Arm'), Robot('B', 'Arm'), Robot('C', 'Eye')),
+                      jobs=(Job('x', 'here', ((1, 1),)), Job('y', 'here', ((2, 2),)),
+                            Job('z', 'here', ((3,),))),
+                      precedence=(('y', 'z'),))
+    start = Schedule({'x': JobAssignment('x', 0, Fraction(0), Fraction(5), {'A': 1, 'B': 1}),
+                      'y': JobAssignment('y', 0, Fraction(5), Fraction(6), {'A': 2, 'B': 2}),
+                      'z': JobAssignment('z', 0, Fraction(6), Fraction(11), {'C': 3})},
+                     {'A': ('x', 'y'), 'B': ('x', 'y'), 'C': ('z',)})
+    assert validate(problem, start) == []
+    found, _ = local_search(problem, start, time.monotonic() + 1)
+    assert validate(problem, found) == []
+    assert found.makespan == 6
+
+
 def test_generated_scenarios_stay_valid_and_no_longer():
     """Holding arcs, travel and multi-robot jobs: every move keeps the holders' direct legs
     and precedence, so the result validates and is no longer than the greedy start."""

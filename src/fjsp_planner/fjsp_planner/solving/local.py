@@ -8,8 +8,9 @@ it on a robot or by precedence, that ends at the makespan) and tries, for each:
 
 - giving one of its operations to another able robot, put into that robot's order where the
   job's current start falls (or one place earlier or later);
-- swapping it with the job before or after it on one of its robots, or moving it on that
-  robot's route next to a job at the same place (the legs around it vanish).
+- swapping it with the job before or after it on one of its robots (on every robot the two
+  share: swapped on one only, their order on another would close a cycle), or moving it on
+  that robot's route next to a job at the same place (the legs around it vanish).
 
 Each move is first estimated by the longest path through what it changes, from the current
 times and each job's longest way to the end (as in Mastrolilli and Gambardella's tabu
@@ -346,7 +347,7 @@ class _Around:
             _, r, k = move
             order = solution.orders[r]
             x, y = order[k], order[k + 1]
-            shared = [r]
+            shared = [s for s in solution.robots[x] if s in solution.robots[y]]
             end, tail, between = solution.end, self.tail, inst.between
             here_x, here_y = location[x], location[y]
             before_x = solution.previous[x] or {}
@@ -458,8 +459,12 @@ def _apply(current: _Solution, move) -> _Solution:
         moved.orders[other].insert(place, j)
     elif move[0] == 'swap':
         _, r, k = move
-        order = moved.orders[r]
-        order[k], order[k + 1] = order[k + 1], order[k]
+        x, y = current.orders[r][k], current.orders[r][k + 1]
+        for s in current.robots[x]:
+            if s in current.robots[y]:
+                order = moved.orders[s]
+                order.remove(y)
+                order.insert(order.index(x), y)
     else:
         _, r, j, m = move
         order = moved.orders[r]
