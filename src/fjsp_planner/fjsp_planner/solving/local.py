@@ -390,7 +390,8 @@ class _Around:
 def _best_move(inst: _Instance, current: _Solution, rng, tabu, step, record):
     """The best solution one move from `current` around a job of its critical path, and that
     job; a job tabu until a later step is moved only to beat `record`. Moves are ranked by
-    an estimate; the EXACT_MOVES best of them are timed."""
+    an estimate; the EXACT_MOVES best of them are timed, but a tabu job's only when their
+    estimate beats `record` (else nearly all the timings go to tabu jobs' moves)."""
     around = _Around(inst, current)
     ranked = []
     for j in current.critical():
@@ -398,11 +399,14 @@ def _best_move(inst: _Instance, current: _Solution, rng, tabu, step, record):
             ranked.append((around.estimate(inst, move), rng.random(), j, move))
     ranked.sort(key=lambda e: (e[0], e[1]))
     best, job, timed = None, None, 0
-    for _, _, j, move in ranked:
+    for estimate, _, j, move in ranked:
+        banned = tabu.get(j, 0) > step
+        if banned and estimate >= record.makespan - 1e-9:
+            continue
         moved = _apply(current, move)
         if not moved.evaluate(inst):
             continue
-        if tabu.get(j, 0) > step and not moved.better(record):
+        if banned and not moved.better(record):
             continue
         timed += 1
         if best is None or moved.better(best):
