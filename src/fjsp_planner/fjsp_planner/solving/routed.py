@@ -3,7 +3,8 @@ search side by side, from the start (docs/solver.md, "Local search").
 
 CP-SAT runs in a thread of its own from the start's schedule, for its bound and its own
 improvements (up to MAX_PAIRWISE_JOBS jobs without its linear relaxation and with the travel
-between every two jobs of a robot, which prove such scenarios sooner); the local search
+between every two jobs of a robot, which prove such scenarios sooner; beyond, with one worker
+fewer, since the search then finds the schedules and needs a core); the local search
 (`local`) runs meanwhile from the same schedule, and the fleet load and chain bounds
 (`bounds.assignment`, `bounds.chains`) one after the other in a thread of their own, each
 briefly (the first for a fixed amount of CP-SAT's work, the second for a share of the limit).
@@ -69,7 +70,9 @@ def solve_routed(problem: Problem, start: Start, began: float, time_limit: float
     first = start.best
     setup = time.monotonic() - began
     small = len(problem.jobs) <= MAX_PAIRWISE_JOBS
-    search = CpsatBeside(problem, deadline, workers, first, start.hint or first, log,
+    # Above MAX_PAIRWISE_JOBS the local search finds the schedules: it gets a core of its own.
+    search = CpsatBeside(problem, deadline, workers if small else max(1, workers - 1), first,
+                         start.hint or first, log,
                          relaxation=not small, pairwise_travel=small)
     load = Beside('fleet load and chain bounds', lambda: search_free_bound(
         problem, time_limit, first.makespan))
