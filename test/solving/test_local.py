@@ -57,6 +57,22 @@ def test_two_jobs_of_the_same_robots_change_places():
     assert found.makespan == 6
 
 
+def test_a_job_changes_to_a_faster_plan():
+    """x can be welded (5 on A) or bolted (1 on A and B at once); started welded, the search
+    bolts it: no other robot can weld, so only the other plan shortens the schedule."""
+    problem = Problem(operation_types={1: 'weld', 2: 'bolt'},
+                      robot_types={'Arm': {1: Fraction(5), 2: Fraction(1)},
+                                   'Driver': {2: Fraction(1)}},
+                      robots=(Robot('A', 'Arm'), Robot('B', 'Driver')),
+                      jobs=(Job('x', 'here', ((1,), (2, 2))),))
+    start = Schedule({'x': JobAssignment('x', 0, Fraction(0), Fraction(5), {'A': 1})},
+                     {'A': ('x',), 'B': ()})
+    assert validate(problem, start) == []
+    found, _ = local_search(problem, start, time.monotonic() + 1)
+    assert validate(problem, found) == []
+    assert found.makespan == 1 and found.jobs['x'].plan == 1
+
+
 def test_generated_scenarios_stay_valid_and_no_longer():
     """Holding arcs, travel and multi-robot jobs: every move keeps the holders' direct legs
     and precedence, so the result validates and is no longer than the greedy start."""

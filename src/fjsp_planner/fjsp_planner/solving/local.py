@@ -8,6 +8,8 @@ it on a robot or by precedence, that ends at the makespan) and tries, for each:
 
 - giving one of its operations to another able robot, put into that robot's order where the
   job's current start falls (or one place earlier or later);
+- doing it by another of its plans: its robots able to do one of that plan's operations keep
+  it, other able robots are drawn for the rest and put into their orders where it starts;
 - swapping it with the job before or after it on one of its robots (on every robot the two
   share: swapped on one only, their order on another would close a cycle), or moving it on
   that robot's route next to a job at the same place (the legs around it vanish).
@@ -40,6 +42,8 @@ TABU_STEPS = (8, 20)
 search does not cycle through a few schedules, short enough that a stall of STALL_STEPS still
 ends in a shake."""
 EXACT_MOVES = 3
+PLAN_STAFFINGS = 3
+"""Random staffings tried per other plan of a job of the critical path, each step."""
 """Moves timed per step, the best estimated: an estimate costs a few lookups, timing a move
 every job."""
 
@@ -53,6 +57,7 @@ class _Instance:
         self.index = {name: k for k, name in enumerate(self.names)}
         self.robots = [r.name for r in p.robots]
         self.location = [p.job(name).location for name in self.names]
+        self.plans = [p.job(name).plans for name in self.names]
         self.predecessors = [[] for _ in self.names]
         for a, b in p.precedence:
             self.predecessors[self.index[b]].append(self.index[a])
@@ -343,6 +348,27 @@ class _Around:
             gone = self.leave(inst, r, old[k - 1] if k > 0 else None,
                               old[k + 1] if k + 1 < len(old) else None)
             return max(at + took + out, gone)
+        if kind == 'plan':
+            _, j, _, staffing, places = move
+            old = solution.robots[j]
+            leaving = [s for s in old if s not in staffing]
+            took = max(inst.times[s][q] for s, q in staffing.items())
+            at = self.inputs(inst, j, leaving)
+            out = self.outputs(inst, j, leaving)
+            for s, place in places.items():
+                order = solution.orders[s]
+                at = max(at, self.reach(inst, s, order[place - 1] if place > 0 else None, j))
+                if place < len(order):
+                    after = order[place]
+                    out = max(out, inst.between[s][location[j]][location[after]]
+                              + self.tail[after])
+            gone = 0.0
+            for s in leaving:
+                order = solution.orders[s]
+                k = order.index(j)
+                gone = max(gone, self.leave(inst, s, order[k - 1] if k > 0 else None,
+                                            order[k + 1] if k + 1 < len(order) else None))
+            return max(at + took + out, gone)
         if kind == 'swap':
             _, r, k = move
             order = solution.orders[r]
@@ -418,8 +444,8 @@ def _best_move(inst: _Instance, current: _Solution, rng, tabu, step, record):
 
 def _moves(inst: _Instance, current: _Solution, j, rng):
     """Moves from `current` around job j: ('give', j, robot, type, other robot, place in its
-    order), ('swap', robot, k: the k-th and next job of its order), ('reinsert', robot, j,
-    place in its order without j)."""
+    order), ('plan', j, plan, staffing, places: see `_plan_move`), ('swap', robot, k: the k-th
+    and next job of its order), ('reinsert', robot, j, place in its order without j)."""
     for r, q in _movable_operations(inst, current, j):
         others = [o for o in inst.robots
                   if o not in current.robots[j] and q in inst.times[o]]
@@ -433,6 +459,12 @@ def _moves(inst: _Instance, current: _Solution, j, rng):
                     yield ('give', j, r, q, other, place)
     if _tied(inst, j):
         return
+    for plan in range(len(inst.plans[j])):
+        if plan != current.plan[j]:
+            for _ in range(PLAN_STAFFINGS):
+                move = _plan_move(inst, current, j, plan, rng)
+                if move is not None:
+                    yield move
     for r in current.robots[j]:
         order = current.orders[r]
         k = order.index(j)
@@ -452,10 +484,48 @@ def _moves(inst: _Instance, current: _Solution, j, rng):
                 yield ('reinsert', r, j, m)
 
 
+def _plan_move(inst: _Instance, current: _Solution, j, plan, rng):
+    """('plan', j, plan, {robot: type}, {robot new to j: place in its order}): j done by
+    another of its plans, keeping those of its robots able to do one of its operations and
+    drawing the others among the able robots, each put into its order where j now starts;
+    None if no draw staffs it."""
+    staffing, places = {}, {}
+    left = list(inst.plans[j][plan])
+    for r, q in current.robots[j].items():
+        for q2 in (q, *left):
+            if q2 in left and q2 in inst.times[r]:
+                staffing[r] = q2
+                left.remove(q2)
+                break
+    rng.shuffle(left)
+    for q in left:
+        able = [o for o in inst.robots if o not in staffing and q in inst.times[o]]
+        if not able:
+            return None
+        other = rng.choice(able)
+        if other in current.robots[j]:
+            staffing[other] = q
+            continue
+        order = current.orders[other]
+        place = sum(1 for k in order if current.start[k] < current.start[j])
+        if _splits_hold(inst, current, other, order, place):
+            return None
+        staffing[other], places[other] = q, place
+    return ('plan', j, plan, staffing, places)
+
+
 def _apply(current: _Solution, move) -> _Solution:
     """The solution `move` makes of `current` (not yet evaluated)."""
     moved = current.copy()
-    if move[0] == 'give':
+    if move[0] == 'plan':
+        _, j, plan, staffing, places = move
+        for r in current.robots[j]:
+            if r not in staffing:
+                moved.orders[r].remove(j)
+        for r, place in places.items():
+            moved.orders[r].insert(place, j)
+        moved.plan[j], moved.robots[j] = plan, dict(staffing)
+    elif move[0] == 'give':
         _, j, r, q, other, place = move
         del moved.robots[j][r]
         moved.robots[j][other] = q
