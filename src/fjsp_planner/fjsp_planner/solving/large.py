@@ -1,11 +1,13 @@
-"""Problems too large for the CP-SAT routing model: the greedy schedule, then randomised
-greedy passes for the rest of the limit (docs/solver.md, "Large problems").
+"""Problems too large for the CP-SAT routing model: the greedy schedule, then the local
+search from it for the rest of the limit, or randomised greedy passes when no greedy schedule
+came in time (docs/solver.md, "Large problems").
 
 The CP-SAT model has one routing arc per robot and ordered pair of jobs it could do: past
 `CPSAT_ROUTING_ARCS` building it alone takes longer than a usual limit and its memory grows
 with the square of the jobs. The greedy's memory and time grow with the jobs and the ready
 ones among them, so it schedules up to the scenario size limit (docs/scenario-format.md,
-"Limits").
+"Limits"); the local search's tables grow with the jobs and the places, and a step with the
+critical path.
 """
 
 import time
@@ -14,6 +16,7 @@ from fjsp_planner.model.problem import Problem
 from fjsp_planner.model.schedule import Result, Status
 from fjsp_planner.solving.bounds.fleet import static_bound
 from fjsp_planner.solving.greedy import sampled_schedule
+from fjsp_planner.solving.local import local_search
 from fjsp_planner.solving.start import Start
 
 CPSAT_ROUTING_ARCS = 400_000
@@ -40,23 +43,28 @@ def fits_cpsat(problem: Problem) -> bool:
 
 def solve_large(problem: Problem, start: Start, began: float, time_limit: float,
                 seed: int = 0) -> Result:
-    """The best of the start and randomised greedy passes until the limit, with the static
-    bound (`bounds.fleet.static_bound`)."""
-    best = start.best
-    first_at = time.monotonic() - began if best is not None else None
-    best_at = first_at
-    found = sampled_schedule(problem, began + time_limit, seed)
-    if found is not None and (best is None or found.makespan < best.makespan):
-        best, best_at = found, time.monotonic() - began
-        first_at = first_at if first_at is not None else best_at
+    """The local search from the start until the limit (without a start, the best of
+    randomised greedy passes), with the static bound (`bounds.fleet.static_bound`)."""
+    deadline = began + time_limit
+    best, solver = start.best, 'greedy'
+    if best is not None:
+        first_at = best_at = time.monotonic() - began
+        how = 'the local search from the greedy schedule'
+        found, found_at = local_search(problem, best, deadline, seed=seed)
+        if found is not best:
+            best, best_at, solver = found, found_at - began, 'local search'
+    else:
+        how = 'randomised greedy passes'
+        best = sampled_schedule(problem, deadline, seed)
+        first_at = best_at = time.monotonic() - began
     elapsed = time.monotonic() - began
     if best is None:
         return Result(Status.UNKNOWN, None, None, elapsed, None, 'greedy',
                       notes=start.notes + ('no greedy pass finished in time',))
     bound = min(static_bound(problem), best.makespan)
     return Result(Status.OPTIMAL if bound >= best.makespan else Status.FEASIBLE,
-                  best.makespan, bound, elapsed, best, 'greedy',
+                  best.makespan, bound, elapsed, best, solver,
                   first_solution_seconds=first_at, best_solution_seconds=best_at,
                   notes=start.notes + (f'{routing_arcs(problem)} routing arcs are more than '
                                        f'the CP-SAT model takes ({CPSAT_ROUTING_ARCS}); '
-                                       'randomised greedy passes',))
+                                       f'{how}',))
