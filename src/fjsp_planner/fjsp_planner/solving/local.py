@@ -42,10 +42,10 @@ TABU_STEPS = (8, 20)
 search does not cycle through a few schedules, short enough that a stall of STALL_STEPS still
 ends in a shake."""
 EXACT_MOVES = 3
-PLAN_STAFFINGS = 3
-"""Random staffings tried per other plan of a job of the critical path, each step."""
 """Moves timed per step, the best estimated: an estimate costs a few lookups, timing a move
 every job."""
+PLAN_STAFFINGS = 3
+"""Random staffings tried per other plan of a job of the critical path, each step."""
 
 
 class _Instance:
