@@ -318,99 +318,88 @@ class _Around:
                         longest = way
         return longest
 
-    def leave(self, inst, r, before, after):
-        """The longest path through robot r's new leg from `before` to `after` once the job
-        between them is gone."""
+    def onward(self, inst, r, j, after):
+        """The longest way to the end through robot r's leg from j to `after` (0 if None)."""
         if after is None:
             return 0.0
-        return self.reach(inst, r, before, after) + self.tail[after]
+        return inst.between[r][inst.location[j]][inst.location[after]] + self.tail[after]
+
+    def closing(self, inst, r, j):
+        """The longest path through the leg that closes robot r's order once j leaves it."""
+        order = self.solution.orders[r]
+        k = order.index(j)
+        if k + 1 == len(order):
+            return 0.0
+        after = order[k + 1]
+        return (self.reach(inst, r, order[k - 1] if k > 0 else None, after)
+                + self.tail[after])
 
     def estimate(self, inst, move) -> float:
         """The longest path through what the move changes, in the current times."""
-        solution, location = self.solution, inst.location
+        solution = self.solution
         kind = move[0]
+        if kind == 'swap':
+            return self._swap(inst, *move[1:])
         if kind == 'give':
             _, j, r, q, other, place = move
-            order = solution.orders[other]
-            before = order[place - 1] if place > 0 else None
-            after = order[place] if place < len(order) else None
             took = inst.times[other][q]
             for s, qs in solution.robots[j].items():
                 if s != r and inst.times[s][qs] > took:
                     took = inst.times[s][qs]
-            at = max(self.inputs(inst, j, (r,)), self.reach(inst, other, before, j))
-            out = self.outputs(inst, j, (r,))
-            if after is not None:
-                out = max(out, inst.between[other][location[j]][location[after]]
-                          + self.tail[after])
-            old = solution.orders[r]
-            k = old.index(j)
-            gone = self.leave(inst, r, old[k - 1] if k > 0 else None,
-                              old[k + 1] if k + 1 < len(old) else None)
-            return max(at + took + out, gone)
+            return self._moved(inst, j, took, (r,), ((other, solution.orders[other], place),))
         if kind == 'plan':
             _, j, _, staffing, places = move
-            old = solution.robots[j]
-            leaving = [s for s in old if s not in staffing]
             took = max(inst.times[s][q] for s, q in staffing.items())
-            at = self.inputs(inst, j, leaving)
-            out = self.outputs(inst, j, leaving)
-            for s, place in places.items():
-                order = solution.orders[s]
-                at = max(at, self.reach(inst, s, order[place - 1] if place > 0 else None, j))
-                if place < len(order):
-                    after = order[place]
-                    out = max(out, inst.between[s][location[j]][location[after]]
-                              + self.tail[after])
-            gone = 0.0
-            for s in leaving:
-                order = solution.orders[s]
-                k = order.index(j)
-                gone = max(gone, self.leave(inst, s, order[k - 1] if k > 0 else None,
-                                            order[k + 1] if k + 1 < len(order) else None))
-            return max(at + took + out, gone)
-        if kind == 'swap':
-            _, r, k = move
-            order = solution.orders[r]
-            x, y = order[k], order[k + 1]
-            shared = [s for s in solution.robots[x] if s in solution.robots[y]]
-            end, tail, between = solution.end, self.tail, inst.between
-            here_x, here_y = location[x], location[y]
-            before_x = solution.previous[x] or {}
-            after_x, after_y = self.following[x] or {}, self.following[y] or {}
-            start_y = self.inputs(inst, y, shared)
-            for s in shared:
-                start_y = max(start_y, self.reach(inst, s, before_x.get(s), y))
-            end_y = start_y + end[y] - solution.start[y]
-            start_x = self.inputs(inst, x, shared)
-            out_x = self.outputs(inst, x, shared)
-            back = 0.0
-            for s in shared:
-                leg = between[s][here_y][here_x]
-                start_x = max(start_x, end_y + leg)
-                after = after_x[s]
-                if after == y:
-                    after = after_y.get(s)
-                if after is not None:
-                    out_x = max(out_x, between[s][here_x][location[after]] + tail[after])
-                back = max(back, leg)
-            tail_x = end[x] - solution.start[x] + out_x
-            tail_y = end[y] - solution.start[y] + max(self.outputs(inst, y, shared),
-                                                      back + tail_x)
-            return max(start_y + tail_y, start_x + tail_x)
+            leaving = [s for s in solution.robots[j] if s not in staffing]
+            return self._moved(inst, j, took, leaving,
+                               [(s, solution.orders[s], place) for s, place in places.items()])
         _, r, j, m = move
         order = solution.orders[r]
         k = order.index(j)
         rest = order[:k] + order[k + 1:]
-        before = rest[m - 1] if m > 0 else None
-        after = rest[m] if m < len(rest) else None
-        at = max(self.inputs(inst, j, (r,)), self.reach(inst, r, before, j))
-        out = self.outputs(inst, j, (r,))
-        if after is not None:
-            out = max(out, inst.between[r][location[j]][location[after]] + self.tail[after])
-        gone = self.leave(inst, r, order[k - 1] if k > 0 else None,
-                          order[k + 1] if k + 1 < len(order) else None)
-        return max(at + solution.end[j] - solution.start[j] + out, gone)
+        return self._moved(inst, j, solution.end[j] - solution.start[j], (r,), ((r, rest, m),))
+
+    def _moved(self, inst, j, took, leaving, entering):
+        """Job j, `took` long, left by the robots `leaving` and put by each robot of
+        `entering` (robot, its order without j, place) into that order."""
+        at = self.inputs(inst, j, leaving)
+        out = self.outputs(inst, j, leaving)
+        for r, order, place in entering:
+            at = max(at, self.reach(inst, r, order[place - 1] if place > 0 else None, j))
+            out = max(out, self.onward(inst, r, j, order[place] if place < len(order) else None))
+        longest = at + took + out
+        for r in leaving:
+            gone = self.closing(inst, r, j)
+            if gone > longest:
+                longest = gone
+        return longest
+
+    def _swap(self, inst, r, k):
+        """x, the k-th job of robot r's order, and y, the next, swapped on every robot they
+        share."""
+        solution, location = self.solution, inst.location
+        order = solution.orders[r]
+        x, y = order[k], order[k + 1]
+        shared = [s for s in solution.robots[x] if s in solution.robots[y]]
+        end, between = solution.end, inst.between
+        before_x = solution.previous[x] or {}
+        after_x, after_y = self.following[x] or {}, self.following[y] or {}
+        start_y = self.inputs(inst, y, shared)
+        for s in shared:
+            start_y = max(start_y, self.reach(inst, s, before_x.get(s), y))
+        end_y = start_y + end[y] - solution.start[y]
+        start_x = self.inputs(inst, x, shared)
+        out_x = self.outputs(inst, x, shared)
+        back = 0.0
+        for s in shared:
+            leg = between[s][location[y]][location[x]]
+            start_x = max(start_x, end_y + leg)
+            after = after_x[s]
+            out_x = max(out_x, self.onward(inst, s, x, after_y.get(s) if after == y else after))
+            back = max(back, leg)
+        tail_x = end[x] - solution.start[x] + out_x
+        tail_y = end[y] - solution.start[y] + max(self.outputs(inst, y, shared), back + tail_x)
+        return max(start_y + tail_y, start_x + tail_x)
 
 
 def _best_move(inst: _Instance, current: _Solution, rng, tabu, step, record):
