@@ -11,7 +11,14 @@ from fjsp_planner.model.scenario import parse_scenario
 from fjsp_planner.model.schedule import JobAssignment, Schedule
 from fjsp_planner.model.validate import validate
 from fjsp_planner.solving.greedy import greedy_schedule
-from fjsp_planner.solving.local import _best_move, _from_schedule, _Instance, local_search
+from fjsp_planner.solving.local import (
+    _best_move,
+    _from_schedule,
+    _Instance,
+    _ruined_and_recreated,
+    _to_schedule,
+    local_search,
+)
 
 
 def _slow_and_fast():
@@ -103,3 +110,38 @@ def test_a_tabu_job_moves_only_to_beat_the_best_schedule():
     assert _best_move(inst, current, random.Random(0), tabu, 1, both_fast) == (None, None)
     moved, _ = _best_move(inst, current, random.Random(0), {}, 1, both_fast)
     assert moved.makespan == 5
+
+
+def test_jobs_put_back_gather_by_place():
+    """One robot works 1 on each of w, y at a and x, z at b, 10 apart. Done w, x, y, z it
+    crosses three times (ends at 34); taken out and put back, each job goes next to one at
+    its place: one crossing, the schedule ends at 14."""
+    problem = Problem(operation_types={0: 'work', 1: 'move'},
+                      robot_types={'Arm': {0: Fraction(1), 1: Fraction(1)}},
+                      robots=(Robot('A', 'Arm'),),
+                      jobs=(Job('w', 'a', ((0,),)), Job('x', 'b', ((0,),)),
+                            Job('y', 'a', ((0,),)), Job('z', 'b', ((0,),))),
+                      distances={('a', 'b'): Fraction(10), ('b', 'a'): Fraction(10)},
+                      locomote=1)
+    inst = _Instance(problem)
+    alternating = _from_schedule(inst, greedy_schedule(problem))
+    alternating.orders['A'] = [inst.index[j] for j in 'wxyz']
+    assert alternating.evaluate(inst) and alternating.makespan == 34
+    gathered = _ruined_and_recreated(inst, alternating, random.Random(0))
+    assert gathered.evaluate(inst) and gathered.makespan == 14
+
+
+def test_ruined_and_recreated_schedules_stay_valid():
+    """Jobs taken out of generated schedules (holding arcs, travel, multi-robot jobs, several
+    plans) and put back: every job is staffed by one of its plans and the schedule
+    validates, however often it is done."""
+    for seed in (1, 2, 3):
+        problem = parse_scenario(random_scenario(seed, Shape(jobs=30, robots=5)))
+        inst = _Instance(problem)
+        current = _from_schedule(inst, greedy_schedule(problem))
+        assert current.evaluate(inst)
+        rng = random.Random(seed)
+        for _ in range(20):
+            current = _ruined_and_recreated(inst, current, rng)
+            assert current.evaluate(inst)
+            assert validate(problem, _to_schedule(inst, current)) == []
