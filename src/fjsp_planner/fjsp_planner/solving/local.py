@@ -21,9 +21,14 @@ search makes the best that shortens the makespan, or that keeps it and shortens 
 of job ends (which frees robots earlier), or else the least bad one; a job moved is left
 where it is for some steps (tabu) unless moving it beats the best schedule, so the search
 walks on past a local optimum instead of undoing its last move. After some steps without a
-better schedule it shakes the best one by a few random moves. Jobs of holding arcs keep
-their holders and their order (the holders go directly from one to the other); running
-(fixed) jobs are never moved. A move whose orders and precedence close a cycle is refused.
+better schedule it ruins and recreates the best one: a job of its critical path and the jobs
+nearest it in time that share its place or one of its robots leave the schedule, and each in
+turn, earliest first, is put back where it ends the schedule soonest (by any of a few random
+staffings of any of its plans, each robot's place in its order chosen by estimate, the best
+few timed), which lets a stretch of several robots' routes change at once. Jobs of holding
+arcs keep their holders and their order (the holders go directly from one to the other);
+running (fixed) jobs are never moved. A move whose orders and precedence close a cycle is
+refused.
 """
 
 import random
