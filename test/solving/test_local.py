@@ -6,7 +6,7 @@ import time
 from fractions import Fraction
 
 from fjsp_planner.model.generator import Shape, random_scenario
-from fjsp_planner.model.problem import Job, Problem, Robot
+from fjsp_planner.model.problem import FixedJob, Job, Problem, Robot
 from fjsp_planner.model.scenario import parse_scenario
 from fjsp_planner.model.schedule import JobAssignment, Schedule
 from fjsp_planner.model.validate import validate
@@ -89,6 +89,29 @@ def test_generated_scenarios_stay_valid_and_no_longer():
         found, _ = local_search(problem, start, time.monotonic() + 0.5, seed=seed)
         assert validate(problem, found) == []
         assert found.makespan <= start.makespan
+
+
+def test_no_job_is_put_before_a_running_one():
+    """A (welds in 1) runs f at a from 0 to 5; B (welds in 5) does x then y at b, 1 away:
+    the schedule ends at 10. Put before f on A, y would seem to end at 2 but overlap f; after
+    f it ends at 7 (x stays on B), the optimum."""
+    problem = Problem(operation_types={1: 'weld', 2: 'move'},
+                      robot_types={'Fast': {1: Fraction(1), 2: Fraction(1)},
+                                   'Slow': {1: Fraction(5), 2: Fraction(1)}},
+                      robots=(Robot('A', 'Fast', start_location='a'),
+                              Robot('B', 'Slow', start_location='b')),
+                      jobs=(Job('f', 'a', ((1,),)), Job('x', 'b', ((1,),)),
+                            Job('y', 'b', ((1,),))),
+                      distances={('a', 'b'): Fraction(1), ('b', 'a'): Fraction(1)},
+                      locomote=2, fixed={'f': FixedJob(0, Fraction(0), Fraction(5), {'A': 1})})
+    start = Schedule({'f': JobAssignment('f', 0, Fraction(0), Fraction(5), {'A': 1}),
+                      'x': JobAssignment('x', 0, Fraction(0), Fraction(5), {'B': 1}),
+                      'y': JobAssignment('y', 0, Fraction(5), Fraction(10), {'B': 1})},
+                     {'A': ('f',), 'B': ('x', 'y')})
+    assert validate(problem, start) == []
+    found, _ = local_search(problem, start, time.monotonic() + 1)
+    assert validate(problem, found) == []
+    assert found.makespan == 7
 
 
 def test_a_tabu_job_moves_only_to_beat_the_best_schedule():

@@ -27,8 +27,8 @@ turn, earliest first, is put back where it ends the schedule soonest (by any of 
 staffings of any of its plans, each robot's place in its order chosen by estimate, the best
 few timed), which lets a stretch of several robots' routes change at once. Jobs of holding
 arcs keep their holders and their order (the holders go directly from one to the other);
-running (fixed) jobs are never moved. A move whose orders and precedence close a cycle is
-refused.
+running (fixed) jobs are never moved. A move whose orders and precedence close a cycle, or that
+puts a job before a running one without room for it, is refused.
 """
 
 import random
@@ -120,7 +120,9 @@ class _Solution:
                          {r: list(o) for r, o in self.orders.items()})
 
     def evaluate(self, inst: _Instance) -> bool:
-        """Earliest times; False if the orders and precedence close a cycle."""
+        """Earliest times; False if the orders and precedence close a cycle, or a robot
+        cannot reach a running (fixed) job from the job before it in its order by its
+        start."""
         n = len(inst.names)
         previous = [None] * n
         waiting = [len(before) for before in inst.predecessors]
@@ -143,6 +145,10 @@ class _Solution:
             timed.append(j)
             if j in fixed:
                 start[j], end[j] = fixed[j]
+                # A running job starts where it is: a job put before it must make way.
+                for r, before in (previous[j] or {}).items():
+                    if end[before] + between[r][location[before]][location[j]] > start[j] + 1e-9:
+                        return False
             else:
                 here = location[j]
                 at, by = 0.0, None
