@@ -290,8 +290,9 @@ class RobotAgent(Node):
         self.last_state = None
         early = [e for e in self.early_events if e.mission_id == msg.mission_id]
         self.early_events.clear()
+        # Verified when heard: checked again, each would be refused as a replay of itself.
         for event in early:
-            self.on_event(event)
+            self.take_event(event)
 
     def cancel(self, msg: Plan) -> None:
         now = max(self.now_units(), 0.0)
@@ -313,6 +314,10 @@ class RobotAgent(Node):
             # The plan of a mission may come after the first reports of the others.
             self.early_events.append(msg)
             return
+        self.take_event(msg)
+
+    def take_event(self, msg: TaskEvent) -> None:
+        """Record a verified report of the followed mission."""
         kind = EVENT_FROM_MSG.get(msg.kind)
         if kind is None or (msg.robot == self.robot and kind != EventKind.JOB_DONE):
             return
