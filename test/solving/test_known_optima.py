@@ -17,6 +17,7 @@ from fjsp_planner.solving.bounds.chains import chain_bound
 from fjsp_planner.solving.bounds.fleet import static_bound
 from fjsp_planner.solving.bounds.load import panel_load_bound
 from fjsp_planner.solving.bounds.machine import panel_machine_bound
+from fjsp_planner.solving.bounds.operations import operation_bound
 from fjsp_planner.solving.bounds.sequence import panel_sequence_bound
 from fjsp_planner.solving.solve import solve
 
@@ -74,8 +75,9 @@ def bound_checks():
 
 @pytest.mark.parametrize('name', list(bound_checks()))
 def test_every_bound_stays_at_or_below_the_known_optimum(name):
-    """The static, fleet load and chain bounds on every entry; on panels, the panel bounds too,
-    given a schedule just above the optimum (as the search would report one)."""
+    """The static, fleet load, chain and operation set bounds on every entry; on panels, the
+    panel bounds too, given a schedule just above the optimum (as the search would report
+    one)."""
     entry = KNOWN[name]
     problem = entry.problem()
     assert static_bound(problem) <= entry.optimum
@@ -83,6 +85,8 @@ def test_every_bound_stays_at_or_below_the_known_optimum(name):
     assert load is None or load <= entry.optimum, 'fleet load'
     chains = chain_bound(problem, 10)
     assert chains is None or chains <= entry.optimum, 'chains'
+    operations = operation_bound(problem, 10)
+    assert operations is None or operations <= entry.optimum, 'operation sets'
     if not problem.panels:
         return
     incumbent = entry.optimum + 1

@@ -5,10 +5,11 @@ CP-SAT runs in a thread of its own from the start's schedule, for its bound and 
 improvements (up to MAX_PAIRWISE_JOBS jobs without its linear relaxation and with the travel
 between every two jobs of a robot, which prove such scenarios sooner; beyond, with one worker
 fewer, since the search then finds the schedules and needs a core); the local search
-(`local`) runs meanwhile from the same schedule, and the fleet load and chain bounds
-(`bounds.assignment`, `bounds.chains`) one after the other in a thread of their own, each
-briefly (the first for a fixed amount of CP-SAT's work, the second for a share of the limit).
-The shorter schedule wins; the bound is the best of CP-SAT's, the static bound and those two.
+(`local`) runs meanwhile from the same schedule, and the fleet load, operation set and chain
+bounds (`bounds.assignment`, `bounds.operations`, `bounds.chains`) one after the other in a
+thread of their own, each briefly (the first for a fixed amount of CP-SAT's work, the others
+for a share of the limit). The shorter schedule wins; the bound is the best of CP-SAT's, the
+static bound and those three.
 """
 
 import time
@@ -20,6 +21,7 @@ from fjsp_planner.solving.beside import Beside, CpsatBeside
 from fjsp_planner.solving.bounds.assignment import fleet_load_bound
 from fjsp_planner.solving.bounds.chains import chain_bound
 from fjsp_planner.solving.bounds.fleet import static_bound
+from fjsp_planner.solving.bounds.operations import operation_bound
 from fjsp_planner.solving.local import local_search
 from fjsp_planner.solving.start import Start
 
@@ -41,6 +43,9 @@ LOAD_BOUND_MOST_SHARE = 0.15
 CHAIN_BOUND_SHARE = 0.1
 """Share of the time limit for the chain bound, after the fleet load bound, beside the
 search."""
+OPERATION_BOUND_SHARE = 0.15
+"""Share of the time limit for the operation set bound, after the chain bound, beside the
+search."""
 
 
 def applies(problem: Problem, start: Start, keep) -> bool:
@@ -53,12 +58,13 @@ def applies(problem: Problem, start: Start, keep) -> bool:
 
 def search_free_bound(problem: Problem, time_limit: float,
                       incumbent: Fraction | None = None) -> Fraction | None:
-    """The better of the fleet load bound and the chain bound, one after the other on one
-    core: the first until it has done `LOAD_BOUND_WORK` (within its most share of
-    `time_limit`), the second in its share; None when neither applies."""
+    """The best of the fleet load, chain and operation set bounds, one after the other on
+    one core: the first until it has done `LOAD_BOUND_WORK` (within its most share of
+    `time_limit`), the others in their shares; None when none applies."""
     found = [bound for bound in (
         fleet_load_bound(problem, LOAD_BOUND_MOST_SHARE * time_limit, incumbent=incumbent,
                          work=LOAD_BOUND_WORK),
+        operation_bound(problem, OPERATION_BOUND_SHARE * time_limit, incumbent=incumbent),
         chain_bound(problem, CHAIN_BOUND_SHARE * time_limit, incumbent=incumbent))
         if bound is not None]
     return max(found, default=None)

@@ -10,6 +10,7 @@ from fjsp_planner.model.schedule import Result, Schedule, Status
 from fjsp_planner.solving import large, portfolio, routed, tabu
 from fjsp_planner.solving.bounds.assignment import fleet_load_bound
 from fjsp_planner.solving.bounds.chains import chain_bound
+from fjsp_planner.solving.bounds.operations import operation_bound
 from fjsp_planner.solving.classic import solve_classic
 from fjsp_planner.solving.compact import left_shifted
 from fjsp_planner.solving.cpsat import solve_cpsat
@@ -93,13 +94,14 @@ def _backend(problem, solver, start, began, time_limit, workers, keep, mip_backe
         return run_from(problem, start, began, time_limit, lambda left: solve_cpsat(
             problem, left, workers, hint=start.hint, keep=keep, upper_bound=start.best,
             log=log))
-    # A proven bound lets CP-SAT stop as soon as a schedule meets it. The chain bound gets
-    # the end of the limit, and only when CP-SAT has not proven its schedule optimal by then:
-    # small scenarios are often proven in less. The robots' routes would delay CP-SAT's
-    # start by about a second, for a floor still below the optimum. The search goes without
-    # CP-SAT's linear relaxation, and with the travel between every two jobs of a robot:
-    # both prove these scenarios sooner. That travel is quadratic in the jobs: a large
-    # scenario comes here only when no start was found, and then needs its time to search.
+    # A proven bound lets CP-SAT stop as soon as a schedule meets it. The operation set and
+    # chain bounds get the end of the limit, and only when CP-SAT has not proven its
+    # schedule optimal by then: small scenarios are often proven in less. The robots' routes
+    # would delay CP-SAT's start by about a second, for a floor still below the optimum. The
+    # search goes without CP-SAT's linear relaxation, and with the travel between every two
+    # jobs of a robot: both prove these scenarios sooner. That travel is quadratic in the
+    # jobs: a large scenario comes here only when no start was found, and then needs its
+    # time to search.
     bound = fleet_load_bound(problem, routed.LOAD_BOUND_SHARE * time_limit, routes=False)
     result = run_from(
         problem, start, began, (1 - routed.CHAIN_BOUND_SHARE) * time_limit,
@@ -108,11 +110,15 @@ def _backend(problem, solver, start, began, time_limit, workers, keep, mip_backe
                                  pairwise_travel=len(problem.jobs) <= routed.MIN_JOBS))
     if result.status == Status.OPTIMAL or result.schedule is None:
         return result
+    operations = operation_bound(problem, (began + time_limit - time.monotonic()) / 2,
+                                 result.makespan)
     chains = chain_bound(problem, began + time_limit - time.monotonic(), result.makespan)
-    if chains is None:
+    found = [bound for bound in (operations, chains) if bound is not None]
+    if not found:
         return result
     return dataclasses.replace(
-        raised_bound(result, chains, 'bound raised to {} by the chain bound'),
+        raised_bound(result, max(found), 'bound raised to {} by the operation set and chain '
+                                         'bounds'),
         solve_seconds=time.monotonic() - began)
 
 
