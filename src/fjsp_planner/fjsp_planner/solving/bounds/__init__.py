@@ -7,8 +7,10 @@
   arrival, energy over capability groups, a robot alone with its travel;
 - `assignment`: the "fleet load" bound for any scenario, each robot's work and travel
   with the staffing of every job chosen by CP-SAT;
-- `chains`: the "chain" bound for any scenario, its longest precedence chains each solved
-  by CP-SAT as a scenario of its own;
+- `restricted`: bounds from sets of jobs, each solved by CP-SAT as a scenario of its own
+  with heads and tails; the sets of `chains` (the "chain" bound: the longest precedence
+  chains) and of `operations` (the "operation set" bound: the jobs that need one operation
+  type);
 - `panel`: the panel decomposition bounds for identical panels (energy, clique) and the
   panel limits of robots slow to move between panels;
 - `machine`: the "panel machine" relaxation CP-SAT solves to optimality;
