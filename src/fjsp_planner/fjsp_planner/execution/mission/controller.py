@@ -125,8 +125,9 @@ class Mission:
     published_at: float | None = None
     """Wall seconds when the latest revision was published (or, resumed, when the mission
     was rebuilt)."""
-    resent: int = 0
-    """The latest revision published again for a robot that had not taken it."""
+    resent: tuple[int, float] | None = None
+    """The latest revision published again for a robot that had not taken it, and the wall
+    time it was last published again."""
     missed: dict[str, int] = field(default_factory=dict)
     """Robot -> the revision it did not take within `plan_uptake_timeout`: it is planned
     without until it reports the latest revision."""

@@ -38,9 +38,10 @@ joiners."""
 
 PLAN_RESEND_AFTER = 2.0
 """Seconds a robot that reports may stay on an older plan revision than the latest before
-the plan is published again, on a new writer: a sample lost on a matched subscription is
-resent by the reliable writer long before, so the robot's subscription is likely not matched
-to the writer at all."""
+the plan is published again, on a new writer, and again every as many seconds until the
+robot takes it or is planned without: a sample lost on a matched subscription is resent by
+the reliable writer long before, so the robot's subscription is likely not matched to the
+writer at all, or a flood pushed the plan out of the robot's reader before it was taken."""
 
 FLEET_SILENCE = 3
 """Heartbeat timeouts after which robots are offline although no robot was heard since."""
@@ -262,7 +263,7 @@ class Liveness:
     def check_uptake(self, mission: 'Mission', wall: float, uptake_timeout: float
                      ) -> list[Effect]:
         """Robots that report, but not the latest revision: the plan is published again
-        after PLAN_RESEND_AFTER, and they are planned without after `uptake_timeout`, until
+        every PLAN_RESEND_AFTER, and they are planned without after `uptake_timeout`, until
         they report it."""
         if mission.schedule is None or mission.published_at is None:
             return []
@@ -286,8 +287,10 @@ class Liveness:
                 effects.append(Note(MissionEventKind.WARNING, (
                     f"robot '{robot.name}' has not taken plan revision {revision} for "
                     f'{waited:.1f} s: published again',), robot=robot.name))
-            if mission.resent < revision:
-                mission.resent = revision
+            if (mission.resent is None or mission.resent[0] < revision
+                    or (waited < uptake_timeout
+                        and wall - mission.resent[1] >= PLAN_RESEND_AFTER)):
+                mission.resent = (revision, wall)
                 effects.append(ResendPlan(revision))
             if waited >= uptake_timeout:
                 mission.missed.setdefault(robot.name, revision)
