@@ -1,14 +1,19 @@
 """The test harness's waits: a condition on something the observer has not heard yet (no
-mission status, no plan) is not yet true, and a timeout names what it raised."""
+mission status, no plan) is not yet true, and a timeout names what it raised. Its check of
+an executed timeline judges a voided jig job as the planner does."""
 
 import re
+from fractions import Fraction
 from types import SimpleNamespace
 
 import pytest
 
-from fjsp_msgs.msg import MissionStatus
+from fjsp_msgs.msg import MissionStatus, TaskEvent
 from fjsp_planner import testing
 from fjsp_planner.launcher.listener import Listener
+from fjsp_planner.model.schedule import JobAssignment, Schedule
+
+from jig_scenarios import held_then_followed
 
 
 class Unheard(testing.Observer):
@@ -160,3 +165,22 @@ def test_an_unusable_domain_setting_is_named(environment, variable, value, messa
     environment.setenv(variable, value)
     with pytest.raises(RuntimeError, match=re.escape(message)):
         testing.DomainClaim()
+
+
+def test_what_followed_a_voided_completion_met_its_precedence():
+    """T done at 2 and followed by M (2-3), voided when its holder failed, redone 3-5: the
+    planner declared T done twice. M met T's precedence by the first completion."""
+    problem, _ = held_then_followed()
+    executed = Schedule({'T': JobAssignment('T', 0, Fraction(3), Fraction(5), {'B': 1}),
+                         'L': JobAssignment('L', 0, Fraction(5), Fraction(7), {'B': 1}),
+                         'M': JobAssignment('M', 0, Fraction(2), Fraction(3), {'C': 3})},
+                        {'A': (), 'B': ('T', 'L'), 'C': ('M',)})
+    done = [TaskEvent(kind=TaskEvent.KIND_JOB_DONE, mission_id=mission, job=job, time=time)
+            for mission, job, time in (('m', 'T', 2.0), ('m', 'M', 3.0), ('m', 'T', 2.0),
+                                       ('m', 'T', 5.0), ('other', 'M', 1.0),
+                                       ('other', 'M', 9.0))]
+    plans = [SimpleNamespace(mission_id='m')]
+    assert testing.voided_ends(plans, done) == {'T': 2.0}
+    assert testing.validate_executed(problem, executed, testing.voided_ends(plans, done)) == []
+    assert testing.validate_executed(problem, executed) == [
+        "job 'M' starts at 2 before its predecessor 'T' completes at 5"]

@@ -15,6 +15,7 @@ from fjsp_planner.model.scenario import load_scenario, parse_scenario
 from fjsp_planner.model.schedule import JobAssignment, Schedule
 from fjsp_planner.model.validate import validate
 
+from jig_scenarios import held_then_followed
 from repo_paths import PAPER
 
 
@@ -220,6 +221,27 @@ def test_failure_replan_and_completion_give_a_valid_executed_timeline(planned):
     assert validate(problem, executed) == [] and tracker.violations() == []
     assert executed.jobs[jig].start >= now and holder not in executed.jobs[jig].robots
     assert tracker.projected_makespan(0) == executed.makespan
+
+
+def test_a_successor_that_followed_a_voided_jig_job_stays_valid():
+    """A fails at 3, during L: T is voided (its hold is lost) and redone by B before L. M
+    started after T's first completion, which it relied on: the mission is valid, though M
+    ran before T's last one."""
+    problem, first = held_then_followed()
+    assert validate(problem, first) == []
+    tracker = MissionTracker(problem)
+    tracker.set_plan(first, 1)
+    run_plan(tracker, first, until=3)
+    tracker.record_robot_state('A', 'failed', '', '', float('nan'))
+    tracker.record_event('abort', EventKind.ABORTED, 'A', 'L', 1, 3.0)
+    outcome = replan(problem, first, tracker.execution_state(3), time_limit=5)
+    assert outcome.residual.voided == ['T']
+    tracker.set_plan(outcome.schedule, 2)
+    run_plan(tracker, outcome.schedule, revision=2)
+    assert tracker.complete
+    executed = tracker.executed_schedule()
+    assert executed.jobs['M'].start < executed.jobs['T'].end
+    assert tracker.violations() == []
 
 
 # --- no report ever raises ------------------------------------------------------------

@@ -51,7 +51,7 @@ from fjsp_common.contract import (
 from fjsp_common.fleet import PLANNER_NODE, agent_node_name
 from fjsp_common.revisions import Restarts, plan_attempts
 from fjsp_msgs.msg import JobStates, MissionEvent, MissionStatus, Plan, RobotState, TaskEvent
-from fjsp_planner.execution.tracking import relaxed_distances, without_durations
+from fjsp_planner.execution.tracking import met_before, relaxed_distances, without_durations
 from fjsp_planner.faults import inject_fault
 from fjsp_planner.launcher.hosts import HostsUnavailableError, Network
 from fjsp_planner.launcher.listener import Listener, environment
@@ -535,16 +535,32 @@ def check_executed_timeline(problem: Problem, plans, events, durations: bool = T
     if missing:
         raise AssertionError(f'no complete execution reported for {", ".join(missing)}')
     problems = validate_executed(problem if durations else without_durations(problem),
-                                 executed)
+                                 executed, voided_ends(plans, events))
     if problems:
         raise AssertionError('the executed timeline is invalid:\n' + '\n'.join(problems))
     return executed
 
 
-def validate_executed(problem: Problem, executed: Schedule) -> list[str]:
+def validate_executed(problem: Problem, executed: Schedule, voided=None) -> list[str]:
     """What the executed timeline breaks, judged as the planner judges it: a robot may go
     between two of its jobs by the shortest route, through the location of a job it was
-    withdrawn from or that a new revision left out."""
-    return validate(dataclasses.replace(problem, distances=relaxed_distances(problem, executed)),
-                    executed)
+    withdrawn from or that a new revision left out; a job that followed the completion of a
+    jig job voided since (`voided`: job -> when that completion ended, `voided_ends`) met
+    that precedence."""
+    relaxed = dataclasses.replace(problem, distances=relaxed_distances(problem, executed))
+    return validate(met_before(relaxed, executed, voided or {}), executed)
+
+
+def voided_ends(plans, events) -> dict[str, float]:
+    """Job -> when its first completion ended, for the jobs of the missions of `plans` the
+    planner declared done more than once (it voids a jig job whose hold was lost, and
+    declares it done again when redone)."""
+    missions = {p.mission_id for p in plans}
+    completions = defaultdict(dict)
+    for e in events:
+        if e.kind == TaskEvent.KIND_JOB_DONE and e.mission_id in missions:
+            # Declared again by a restarted planner, it is the same completion.
+            same = completions[e.job].setdefault(round(e.time, 6), e.time)
+            completions[e.job][round(e.time, 6)] = min(same, e.time)
+    return {job: min(times.values()) for job, times in completions.items() if len(times) > 1}
 

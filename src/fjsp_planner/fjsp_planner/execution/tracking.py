@@ -63,6 +63,9 @@ class JobRecord:
     """A robot on it failed while working: it waits for a new revision to be redone."""
     done_as: JobAssignment | None = None
     """The plan and robots it was completed with."""
+    voided_end: float | None = None
+    """When its first completion ended, if a re-plan voided it since (a jig job whose hold
+    was lost is redone): what followed that completion started after it, rightly."""
 
     @property
     def start(self) -> float | None:
@@ -141,7 +144,9 @@ class MissionTracker:
             raise ValueError('continued job(s) not in the plan: ' + ', '.join(unknown))
         for name in schedule.jobs:
             if name not in continued:
-                self.jobs[name] = JobRecord(name, since_revision=revision)
+                before = self.jobs.get(name)
+                self.jobs[name] = JobRecord(name, since_revision=revision,
+                                            voided_end=_first_end(before))
         self.plan, self.revision = schedule, revision
         self._failures_at[revision] = {name: r.failures for name, r in self.robots.items()}
 
@@ -188,7 +193,8 @@ class MissionTracker:
         if kind == EventKind.ABORTED:
             if record.end is not None:
                 return Verdict()
-            self.jobs[job] = JobRecord(job, since_revision=record.since_revision, aborted=True)
+            self.jobs[job] = JobRecord(job, since_revision=record.since_revision, aborted=True,
+                                       voided_end=record.voided_end)
             return Verdict()
         if robot in facts[kind] or record.end is not None:
             self.ignored[Ignored.DUPLICATE] += 1
@@ -337,7 +343,7 @@ class MissionTracker:
                       and robot not in self.jobs[name].operation_done)
         for name in lost:
             self.jobs[name] = JobRecord(name, since_revision=self.jobs[name].since_revision,
-                                        aborted=True)
+                                        aborted=True, voided_end=self.jobs[name].voided_end)
         record = self.robots[robot]
         record.failures += 1
         record.last_failure_at = at if _time_ok(at) else self._latest
@@ -601,7 +607,10 @@ class MissionTracker:
             if target in done and source not in done:
                 messages.append(f"job '{target}' is done but '{source}', which holds into "
                                 'it, is not')
-        return messages + validate(self._as_executed(executed), executed)
+        voided = {name: record.voided_end for name, record in self.jobs.items()
+                  if record.voided_end is not None}
+        return messages + validate(met_before(self._as_executed(executed), executed, voided),
+                                   executed)
 
     def _as_executed(self, executed: Schedule) -> Problem:
         """The problem restricted to the executed jobs, operations free of duration and
@@ -614,6 +623,25 @@ class MissionTracker:
             holding=tuple((a, b, q) for a, b, q in p.holding if a in done and b in done),
             distances=relaxed_distances(p, executed), fixed={}, panels=(),
             name=f'{p.name} as executed')
+
+
+def _first_end(record: 'JobRecord | None') -> float | None:
+    """When the job's first completion ended, if it was completed (before being started
+    afresh by a new revision, which only a voided job is once done)."""
+    if record is None:
+        return None
+    return record.voided_end if record.voided_end is not None else record.end
+
+
+def met_before(problem: Problem, executed: Schedule, voided_ends) -> Problem:
+    """`problem` without the precedence arcs (a, b) that a voided completion of a met: b
+    started no earlier than that completion ended (`voided_ends`: job -> its end), and
+    relied on it. A jig job whose hold was lost is redone for the job it holds into, not for
+    what already followed it."""
+    return dataclasses.replace(problem, precedence=tuple(
+        (a, b) for a, b in problem.precedence
+        if not (a in voided_ends and b in executed.jobs
+                and executed.jobs[b].start >= Fraction(voided_ends[a]))))
 
 
 def without_durations(problem: Problem) -> Problem:
