@@ -4,7 +4,7 @@ independently: `test_known_optima.py`."""
 import dataclasses
 from fractions import Fraction
 
-from fjsp_planner.model.problem import FixedJob, Job, Problem, Robot
+from fjsp_planner.model.problem import Job, Problem, Robot
 from fjsp_planner.solving.bounds import chains
 from fjsp_planner.solving.bounds.assignment import fleet_load_bound
 from fjsp_planner.solving.bounds.chains import chain_bound
@@ -68,9 +68,6 @@ def test_two_chains_together_share_their_fast_robot(monkeypatch):
     assert chain_bound(problem, 5) == 7
 
 
-def test_running_jobs_or_no_precedence_get_none():
-    problem = fast_or_near()
-    running = dataclasses.replace(problem, fixed={
-        'x': FixedJob(0, Fraction(0), Fraction(1), {'F': 1})})
-    assert chain_bound(running, 5) is None
-    assert chain_bound(dataclasses.replace(problem, precedence=()), 5) is None
+def test_no_precedence_gets_none():
+    """(Running jobs get no bound from any set of jobs: `test_operations.py`.)"""
+    assert chain_bound(dataclasses.replace(fast_or_near(), precedence=()), 5) is None

@@ -42,11 +42,14 @@ def test_the_jobs_of_a_scarce_operation_weigh_its_robot_s_ways_with_their_window
     assert chain_bound(problem, 5) == 6
 
 
-def test_running_jobs_or_no_two_jobs_needing_one_type_get_none():
-    problem = welds_between_a_carry()
-    running = dataclasses.replace(problem, fixed={
+def test_running_jobs_get_no_bound_from_any_set_of_jobs():
+    """Like those of `fleet`, the bounds of `restricted` hold only without running jobs."""
+    running = dataclasses.replace(welds_between_a_carry(), fixed={
         'x1': FixedJob(0, Fraction(0), Fraction(1), {'F': 1})})
-    assert operation_bound(running, 5) is None
-    one_weld = dataclasses.replace(
-        problem, jobs=problem.jobs[:2], precedence=(('x1', 'm'),))
+    assert operation_bound(running, 5) is None and chain_bound(running, 5) is None
+
+
+def test_no_two_jobs_needing_one_type_get_none():
+    problem = welds_between_a_carry()
+    one_weld = dataclasses.replace(problem, jobs=problem.jobs[:2], precedence=(('x1', 'm'),))
     assert operation_bound(one_weld, 5) is None
