@@ -625,7 +625,7 @@ class MissionTracker:
             name=f'{p.name} as executed')
 
 
-def _first_end(record: 'JobRecord | None') -> float | None:
+def _first_end(record: JobRecord | None) -> float | None:
     """When the job's first completion ended, if it was completed (before being started
     afresh by a new revision, which only a voided job is once done)."""
     if record is None:

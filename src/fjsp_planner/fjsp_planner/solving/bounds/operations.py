@@ -17,8 +17,8 @@ from fjsp_planner.model.problem import Problem
 from fjsp_planner.solving.bounds.restricted import restricted_bound
 
 MOST_JOBS = 16
-"""Largest set tried: on generated scenarios CP-SAT proves sets of 4-10 jobs in tenths of a
-second to 2 s, and rarely proves anything useful on 13 or more within seconds."""
+"""Largest set tried: on generated scenarios CP-SAT proves sets of 4-15 jobs in 0.04 to 2.7 s
+(`restricted`), and none of 18-22 jobs within 4 s."""
 
 
 def operation_bound(problem: Problem, time_limit: float, incumbent: Fraction | None = None
