@@ -106,3 +106,22 @@ def test_a_robot_goes_from_one_place_to_the_next():
                       distances=distances, locomote=2)
     assert fleet_load_bound(problem, 5) == 31 == solve(problem).makespan
     assert fleet_load_bound(problem, 5, routes=False) == 21
+
+
+def test_a_robot_goes_back_and_forth_along_precedence():
+    """W welds x1 at a, y at b, then x2 at a; between y and x2 a carrier C, already at b,
+    carries at b (1). W makes its way a -> b -> a (10): 6 of welds + 10 = 16, the optimum
+    (W goes back while C carries). Its route visits b once: 11; the precedence of y before
+    x2 runs through C's job, so its chains of jobs are read through any job."""
+    distances = {('a', 'b'): Fraction(5), ('b', 'a'): Fraction(5)}
+    problem = Problem(operation_types={1: 'weld', 2: 'move', 3: 'carry'},
+                      robot_types={'Welder': {1: Fraction(2), 2: Fraction(1)},
+                                   'Carrier': {3: Fraction(1), 2: Fraction(1)}},
+                      robots=(Robot('W', 'Welder', start_location='a'),
+                              Robot('C', 'Carrier', start_location='b')),
+                      jobs=(Job('x1', 'a', ((1,),)), Job('y', 'b', ((1,),)),
+                            Job('carry', 'b', ((3,),)), Job('x2', 'a', ((1,),))),
+                      precedence=(('x1', 'y'), ('y', 'carry'), ('carry', 'x2')),
+                      distances=distances, locomote=2)
+    assert fleet_load_bound(problem, 5) == 11
+    assert fleet_load_bound(problem, 5, chains=True) == 16 == solve(problem).makespan

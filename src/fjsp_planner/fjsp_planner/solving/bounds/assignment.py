@@ -10,9 +10,18 @@ once, along the least ways of the distance table. CP-SAT chooses every job's sta
 set of robots, at the least duration that set achieves) to minimise the largest such sum;
 `bounds.fleet` counts the same per robot only for the jobs nobody else can do, and the work
 of a group without its travel. Times are floored onto a grid, which only lowers the bound.
+
+Precedence orders a robot's jobs too: of two of its jobs, one preceding the other through
+any chain of jobs, it does the first first, then makes its way to the second's place, by at
+least the least way there, whatever it does in between. Along a chain of its jobs those ways
+are separate parts of its travel, so its release time, its jobs and the longest such chain of
+ways (from its start location) fit in the makespan too: a robot whose jobs alternate between
+places layer after layer goes back and forth, where its route would visit each place once.
+That model is slower to prove, so it is solved second, from what the first proves.
 """
 
 import math
+import time
 from fractions import Fraction
 
 from ortools.sat.python import cp_model
@@ -26,11 +35,14 @@ MAX_GRID = 1000
 MAX_CHOICES = 20_000
 """Staffing literals beyond which building the model alone would take seconds; large fleets
 go without this bound."""
+MIN_CHAIN_SOLVE = 0.2
+"""Seconds below which the model with chained ways is not tried: it proves nothing more so
+soon."""
 
 
 def fleet_load_bound(problem: Problem, time_limit: float, workers: int = 1,
                      incumbent: Fraction | None = None, routes: bool = True,
-                     work: float | None = None) -> Fraction | None:
+                     work: float | None = None, chains: bool = False) -> Fraction | None:
     """The bound of the module docstring, or None when it does not apply (running jobs, too
     many staffings) or CP-SAT proves nothing in `time_limit` seconds. With `incumbent`, a
     makespan known to be reachable, it never exceeds that. Without `routes`, each robot's
@@ -38,9 +50,11 @@ def fleet_load_bound(problem: Problem, time_limit: float, workers: int = 1,
     in tenths of a second where the routes take seconds. With `work`, CP-SAT also stops
     after that much deterministic time (its own measure of work done, about seconds of one
     core whatever the load), so that the bound is as strong on a busy machine as on an idle
-    one, within `time_limit`."""
+    one, within `time_limit`. With `chains`, the model with each robot's ways along the
+    precedence chains of its jobs is then solved for the rest of `time_limit`."""
     if problem.fixed or not problem.jobs:
         return None
+    started = time.monotonic()
     robots = sorted(r.name for r in problem.robots)
     choices = {}
     count = 0
@@ -49,85 +63,156 @@ def fleet_load_bound(problem: Problem, time_limit: float, workers: int = 1,
         count += len(choices[job.name])
         if count > MAX_CHOICES:
             return None
-    places = {job.location for job in problem.jobs}
-    legs = {(r, place): least_leg_into(problem, r, place) for r in robots for place in places}
-    entries = {(r.name, place): problem.travel(r.name, r.start_location, place)
-               for r in problem.robots if r.start_location is not None for place in places}
-    values = [d for found in choices.values() for d, _ in found]
-    values += [r.release_time for r in problem.robots] + list(legs.values())
-    values += list(entries.values())
-    scale = min(MAX_GRID, math.lcm(*(v.denominator for v in values)))
+    found = _LoadModel(problem, choices, routes).solve(time_limit, workers, work)
+    left = time_limit - (time.monotonic() - started)
+    if (chains and found is not None and left >= MIN_CHAIN_SOLVE
+            and (incumbent is None or found < incumbent) and _places_chained(problem)):
+        model = _LoadModel(problem, choices, routes, chains=True, floor=found)
+        found = max(found, model.solve(left, workers) or found)
+    return found if incumbent is None or found is None else min(found, incumbent)
 
-    def ticks(value: Fraction) -> int:
-        return value.numerator * scale // value.denominator
 
-    horizon = sum(max(ticks(d) for d, _ in found) for found in choices.values())
-    horizon += max(ticks(r.release_time) for r in problem.robots) + max(
-        map(ticks, entries.values()), default=0) + sum(map(ticks, legs.values()))
-    # Room for the longest route: the longest least way into each place.
-    horizon += len(places) * max(
-        (ticks(least_location_travel(problem, r.name, a, b)) for r in problem.robots
-         for a in places | {r.start_location} - {None} for b in places), default=0)
-    m = cp_model.CpModel()
-    makespan = m.new_int_var(0, horizon, 'makespan')
-    load = {r: [] for r in robots}
-    works = {}
-    """(robot, place) -> the literals of the choices that have the robot work there."""
-    for job in problem.jobs:
-        found = choices[job.name]
-        picks = [m.new_bool_var(f'pick_{job.name}_{i}') for i in range(len(found))]
-        m.add_exactly_one(picks)
-        for pick, (duration, members) in zip(picks, found, strict=True):
-            for r in members:
-                load[r].append(pick * ticks(duration))
-                works.setdefault((r, job.location), []).append(pick)
-    places_of = {}
-    """robot -> the places it may work at, in the order of its `visits` literals."""
-    for robot in problem.robots:
-        r = robot.name
-        visits, firsts, travel = [], [], []
-        places_of[r] = []
-        for (who, place), picks in sorted(works.items()):
-            if who != r:
+class _LoadModel:
+    """The CP-SAT model of the module docstring: every job's staffing picked, each robot's
+    release time, load and least travel below the makespan (with `chains`, its ways along
+    the precedence chains of its jobs too; with `floor`, the makespan no less than that)."""
+
+    def __init__(self, problem: Problem, choices, routes: bool, chains: bool = False,
+                 floor: Fraction | None = None):
+        self.problem = problem
+        robots = sorted(r.name for r in problem.robots)
+        places = {job.location for job in problem.jobs}
+        legs = {(r, place): least_leg_into(problem, r, place) for r in robots
+                for place in places}
+        entries = {(r.name, place): problem.travel(r.name, r.start_location, place)
+                   for r in problem.robots if r.start_location is not None
+                   for place in places}
+        values = [d for found in choices.values() for d, _ in found]
+        values += [r.release_time for r in problem.robots] + list(legs.values())
+        values += list(entries.values())
+        self.scale = scale = min(MAX_GRID, math.lcm(*(v.denominator for v in values)))
+        ticks = self.ticks
+        # Room for the longest route: the longest least way into each place.
+        longest_way = max((ticks(least_location_travel(problem, r.name, a, b))
+                           for r in problem.robots
+                           for a in places | {r.start_location} - {None} for b in places),
+                          default=0)
+        horizon = sum(max(ticks(d) for d, _ in found) for found in choices.values())
+        horizon += max(ticks(r.release_time) for r in problem.robots) + max(
+            map(ticks, entries.values()), default=0) + sum(map(ticks, legs.values()))
+        horizon += (len(problem.jobs) if chains else len(places)) * longest_way
+        self.model = m = cp_model.CpModel()
+        self.makespan = makespan = m.new_int_var(0, horizon, 'makespan')
+        load = {r: [] for r in robots}
+        works = {}
+        """(robot, place) -> the literals of the choices that have the robot work there."""
+        picked = {}
+        """(robot, job) -> the literals of the job's choices that give it the robot."""
+        for job in problem.jobs:
+            found = choices[job.name]
+            picks = [m.new_bool_var(f'pick_{job.name}_{i}') for i in range(len(found))]
+            m.add_exactly_one(picks)
+            for pick, (duration, members) in zip(picks, found, strict=True):
+                for r in members:
+                    load[r].append(pick * ticks(duration))
+                    works.setdefault((r, job.location), []).append(pick)
+                    picked.setdefault((r, job.name), []).append(pick)
+        before = problem.ancestors() if chains else None
+        for robot in problem.robots:
+            r = robot.name
+            visits, firsts, travel = [], [], []
+            places_of = []
+            """The places the robot may work at, in the order of its `visits` literals."""
+            for (who, place), picks in sorted(works.items()):
+                if who != r:
+                    continue
+                places_of.append(place)
+                visit = m.new_bool_var(f'visits_{place}_{r}')
+                for pick in picks:
+                    m.add_implication(pick, visit)
+                first = m.new_bool_var(f'first_{place}_{r}')
+                m.add_implication(first, visit)
+                visits.append(visit)
+                firsts.append(first)
+                # The first place is entered from the start location (from nowhere without
+                # one), every other place by at least its least leg.
+                entry = entries.get((r, place), Fraction(0))
+                travel.append(visit * ticks(legs[r, place])
+                              + first * (ticks(entry) - ticks(legs[r, place])))
+            if not visits:
                 continue
-            places_of[r].append(place)
-            visit = m.new_bool_var(f'visits_{place}_{r}')
-            for pick in picks:
-                m.add_implication(pick, visit)
-            first = m.new_bool_var(f'first_{place}_{r}')
-            m.add_implication(first, visit)
-            visits.append(visit)
-            firsts.append(first)
-            # The first place is entered from the start location (from nowhere without
-            # one), every other place by at least its least leg.
-            entry = entries.get((r, place), Fraction(0))
-            travel.append(visit * ticks(legs[r, place])
-                          + first * (ticks(entry) - ticks(legs[r, place])))
-        if not visits:
-            continue
-        m.add_at_most_one(firsts)
-        for visit in visits:
-            m.add(sum(firsts) >= visit)
-        m.add(makespan >= sum(load[r]) + sum(travel) + ticks(robot.release_time))
-        if routes:
-            route = _route_through(m, problem, robot, ticks, places_of[r], visits)
-            m.add(makespan >= sum(load[r]) + route + ticks(robot.release_time))
-    m.minimize(makespan)
-    solver = cp_model.CpSolver()
-    solver.parameters.max_time_in_seconds = max(0.01, time_limit)
-    solver.parameters.num_workers = workers
-    solver.parameters.catch_sigint_signal = False
-    # Only the bound is wanted: with the circuits' and every constraint's cuts in its LP,
-    # CP-SAT proves far more of it in the same time (docs/solver.md, "Fleet load").
-    solver.parameters.linearization_level = 2
-    if work is not None:
-        solver.parameters.max_deterministic_time = work
-    status = solver.solve(m).name
-    if status in ('MODEL_INVALID', 'INFEASIBLE') or not math.isfinite(
-            solver.best_objective_bound):
-        return None
-    found = Fraction(objective_ticks(solver.best_objective_bound), scale)
-    return found if incumbent is None else min(found, incumbent)
+            m.add_at_most_one(firsts)
+            for visit in visits:
+                m.add(sum(firsts) >= visit)
+            busy = sum(load[r]) + ticks(robot.release_time)
+            m.add(makespan >= busy + sum(travel))
+            if routes:
+                m.add(makespan >= busy + _route_through(m, problem, robot, ticks, places_of,
+                                                        visits))
+            if chains:
+                m.add(makespan >= busy + _chained_ways(m, problem, robot, ticks, picked,
+                                                       before, horizon))
+        if floor is not None:
+            m.add(makespan >= -(-floor.numerator * scale // floor.denominator))
+        m.minimize(makespan)
+
+    def ticks(self, value: Fraction) -> int:
+        return value.numerator * self.scale // value.denominator
+
+    def solve(self, time_limit: float, workers: int, work: float | None = None
+              ) -> Fraction | None:
+        """The least makespan CP-SAT proves within `time_limit` (and `work`), or None."""
+        solver = cp_model.CpSolver()
+        solver.parameters.max_time_in_seconds = max(0.01, time_limit)
+        solver.parameters.num_workers = workers
+        solver.parameters.catch_sigint_signal = False
+        # Only the bound is wanted: with the circuits' and every constraint's cuts in its LP,
+        # CP-SAT proves far more of it in the same time (docs/solver.md, "Fleet load").
+        solver.parameters.linearization_level = 2
+        if work is not None:
+            solver.parameters.max_deterministic_time = work
+        status = solver.solve(self.model).name
+        if status in ('MODEL_INVALID', 'INFEASIBLE') or not math.isfinite(
+                solver.best_objective_bound):
+            return None
+        return Fraction(objective_ticks(solver.best_objective_bound), self.scale)
+
+
+def _places_chained(problem: Problem) -> bool:
+    """Whether some job precedes another at another place: else no chain adds a way."""
+    before = problem.ancestors()
+    return any(problem.job(a).location != job.location
+               for job in problem.jobs for a in before[job.name])
+
+
+def _chained_ways(m, problem: Problem, robot, ticks, picked, before, horizon):
+    """The robot's longest chain of ways (module docstring) as a variable of the model: per
+    job it may do, the least time its ways up to that job take along some chain of its jobs,
+    given that it does that job (`picked`: (robot, job) -> the literals giving it the robot;
+    `before`: job -> its ancestors)."""
+    r, start = robot.name, robot.start_location
+    mine = [job for job in problem.jobs if (r, job.name) in picked]
+    longest = m.new_int_var(0, horizon, f'chained_ways_{r}')
+    does, up_to = {}, {}
+    for job in mine:
+        name = job.name
+        does[name] = m.new_bool_var(f'does_{name}_{r}')
+        m.add(does[name] == sum(picked[r, name]))
+        up_to[name] = m.new_int_var(0, horizon, f'ways_to_{name}_{r}')
+        if start is not None:
+            entry = ticks(least_location_travel(problem, r, start, job.location))
+            m.add(up_to[name] >= entry).only_enforce_if(does[name])
+        m.add(longest >= up_to[name])
+    for job in mine:
+        for earlier in mine:
+            # Ways between jobs at one place are 0; a chain through such a pair is also a
+            # pair of jobs at two places, as ancestors are transitive.
+            if earlier.name in before[job.name] and earlier.location != job.location:
+                way = ticks(least_location_travel(problem, r, earlier.location,
+                                                  job.location))
+                m.add(up_to[job.name] >= up_to[earlier.name] + way).only_enforce_if(
+                    [does[earlier.name], does[job.name]])
+    return longest
 
 
 def _route_through(m, problem: Problem, robot, ticks, places, visits):
