@@ -59,11 +59,12 @@ def applies(problem: Problem, start: Start, keep) -> bool:
 def search_free_bound(problem: Problem, time_limit: float,
                       incumbent: Fraction | None = None) -> Fraction | None:
     """The best of the fleet load, chain and operation set bounds, one after the other on
-    one core: the first until it has done `LOAD_BOUND_WORK` (within its most share of
-    `time_limit`), the others in their shares; None when none applies."""
+    one core: the first until it has done `LOAD_BOUND_WORK`, then with chained ways for the
+    rest of its most share of `time_limit`, the others in their shares; None when none
+    applies."""
     found = [bound for bound in (
         fleet_load_bound(problem, LOAD_BOUND_MOST_SHARE * time_limit, incumbent=incumbent,
-                         work=LOAD_BOUND_WORK),
+                         work=LOAD_BOUND_WORK, chains=True),
         operation_bound(problem, OPERATION_BOUND_SHARE * time_limit, incumbent=incumbent),
         chain_bound(problem, CHAIN_BOUND_SHARE * time_limit, incumbent=incumbent))
         if bound is not None]
