@@ -179,7 +179,10 @@ class _LoadModel:
 
 
 def _places_chained(problem: Problem) -> bool:
-    """Whether some job precedes another at another place: else no chain adds a way."""
+    """Whether travel takes time and some job precedes another at another place: else no
+    chain adds a way."""
+    if problem.locomote is None:
+        return False
     before = problem.ancestors()
     return any(problem.job(a).location != job.location
                for job in problem.jobs for a in before[job.name])
