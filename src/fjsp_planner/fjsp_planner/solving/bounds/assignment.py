@@ -102,7 +102,6 @@ class _LoadModel:
 
     def __init__(self, problem: Problem, choices, routes: bool, chains: bool = False,
                  floor: Fraction | None = None):
-        self.problem = problem
         robots = sorted(r.name for r in problem.robots)
         places = {job.location for job in problem.jobs}
         legs = {(r, place): least_leg_into(problem, r, place) for r in robots
@@ -125,7 +124,7 @@ class _LoadModel:
             map(ticks, entries.values()), default=0) + sum(map(ticks, legs.values()))
         horizon += (len(problem.jobs) if chains else len(places)) * longest_way
         self.model = m = cp_model.CpModel()
-        self.makespan = makespan = m.new_int_var(0, horizon, 'makespan')
+        makespan = m.new_int_var(0, horizon, 'makespan')
         load = {r: [] for r in robots}
         works = {}
         """(robot, place) -> the literals of the choices that have the robot work there."""
