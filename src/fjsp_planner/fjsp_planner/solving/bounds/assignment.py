@@ -114,7 +114,8 @@ class _LoadModel:
         values += list(entries.values())
         self.scale = scale = min(MAX_GRID, math.lcm(*(v.denominator for v in values)))
         ticks = self.ticks
-        # Room for the longest route: the longest least way into each place.
+        # Room for the longest route (a longest least way into each place) or chain of ways
+        # (one into each job).
         longest_way = max((ticks(least_location_travel(problem, r.name, a, b))
                            for r in problem.robots
                            for a in places | {r.start_location} - {None} for b in places),
