@@ -3,13 +3,14 @@ search side by side, from the start (docs/solver.md, "Local search").
 
 CP-SAT runs in a thread of its own from the start's schedule, for its bound and its own
 improvements (up to MAX_PAIRWISE_JOBS jobs without its linear relaxation and with the travel
-between every two jobs of a robot, which prove such scenarios sooner; beyond, with one worker
-fewer, since the search then finds the schedules and needs a core); the local search
-(`local`) runs meanwhile from the same schedule, and the fleet load, operation set and chain
-bounds (`bounds.assignment`, `bounds.operations`, `bounds.chains`) one after the other in a
-thread of their own, each briefly (the first for a fixed amount of CP-SAT's work, the others
-for a share of the limit). The shorter schedule wins; the bound is the best of CP-SAT's, the
-static bound and those three.
+between every two jobs of a robot, which prove such scenarios sooner, and with every core:
+its schedules win there, and the local search would only take time from its proofs; beyond,
+with one worker fewer, since the search then finds the schedules and needs a core); the local
+search (`local`) runs meanwhile from the same schedule beyond MAX_PAIRWISE_JOBS, and the
+fleet load, operation set and chain bounds (`bounds.assignment`, `bounds.operations`,
+`bounds.chains`) one after the other in a thread of their own, each briefly (the first for a
+fixed amount of CP-SAT's work, the others for a share of the limit). The shorter schedule
+wins; the bound is the best of CP-SAT's, the static bound and those three.
 """
 
 import time
@@ -28,8 +29,9 @@ from fjsp_planner.solving.start import Start
 MIN_JOBS = 25
 """Up to this many jobs CP-SAT usually proves the optimum in seconds with both cores."""
 MAX_PAIRWISE_JOBS = 40
-"""Up to this many jobs CP-SAT beside the local search goes without its linear relaxation and
-with the travel between every two jobs of a robot, which is quadratic in the jobs."""
+"""Up to this many jobs CP-SAT goes without its linear relaxation and with the travel between
+every two jobs of a robot, which is quadratic in the jobs, and no local search runs beside
+it."""
 LOAD_BOUND_SHARE = 0.05
 """Share of the time limit for the fleet load bound when it runs before CP-SAT (small
 scenarios, `solve`)."""
@@ -83,7 +85,10 @@ def solve_routed(problem: Problem, start: Start, began: float, time_limit: float
                          relaxation=not small, pairwise_travel=small)
     load = Beside('fleet load and chain bounds', lambda: search_free_bound(
         problem, time_limit, first.makespan))
-    best, best_at = local_search(problem, first, deadline, stop=search.done)
+    if small:
+        best, best_at = first, time.monotonic()
+    else:
+        best, best_at = local_search(problem, first, deadline, stop=search.done)
     solver = 'local search' if best is not first else 'greedy'
     result = search.result()
     # The first schedule is valid: CP-SAT claiming infeasibility was given a bound too high.
