@@ -69,14 +69,15 @@ def fleet_load_bound(problem: Problem, time_limit: float, workers: int = 1,
         if count > MAX_CHOICES:
             return None
     found, _ = _LoadModel(problem, choices, routes).solve(time_limit, workers, work)
-    if (chains and found is not None and (incumbent is None or found < incumbent)
-            and _places_chained(problem)):
-        found = _chained_bound(problem, choices, routes, found,
+    before = problem.ancestors() if chains and problem.locomote is not None else None
+    if (before is not None and found is not None and (incumbent is None or found < incumbent)
+            and _places_chained(problem, before)):
+        found = _chained_bound(problem, choices, routes, before, found,
                                started + time_limit - time.monotonic(), workers)
     return found if incumbent is None or found is None else min(found, incumbent)
 
 
-def _chained_bound(problem: Problem, choices, routes: bool, floor: Fraction,
+def _chained_bound(problem: Problem, choices, routes: bool, before, floor: Fraction,
                    time_limit: float, workers: int) -> Fraction:
     """The model with chained ways from `floor`, in `time_limit`: CP-SAT's default search
     first (it proves the easy ones in tenths of a second), then, from what it proved, its
@@ -84,24 +85,24 @@ def _chained_bound(problem: Problem, choices, routes: bool, floor: Fraction,
     if time_limit < MIN_CHAIN_SOLVE:
         return floor
     started = time.monotonic()
-    model = _LoadModel(problem, choices, routes, chains=True, floor=floor)
+    model = _LoadModel(problem, choices, routes, before)
+    model.raise_floor(floor)
     found, proven = model.solve(DEFAULT_SEARCH_SHARE * time_limit, workers)
     floor = max(floor, found or floor)
     left = started + time_limit - time.monotonic()
     if proven or left < MIN_CHAIN_SOLVE:
         return floor
-    model = _LoadModel(problem, choices, routes, chains=True, floor=floor)
+    model.raise_floor(floor)
     found, _ = model.solve(left, workers, tree=True)
     return max(floor, found or floor)
 
 
 class _LoadModel:
     """The CP-SAT model of the module docstring: every job's staffing picked, each robot's
-    release time, load and least travel below the makespan (with `chains`, its ways along
-    the precedence chains of its jobs too; with `floor`, the makespan no less than that)."""
+    release time, load and least travel below the makespan (with `before`, job -> its
+    ancestors, its ways along the precedence chains of its jobs too)."""
 
-    def __init__(self, problem: Problem, choices, routes: bool, chains: bool = False,
-                 floor: Fraction | None = None):
+    def __init__(self, problem: Problem, choices, routes: bool, before=None):
         robots = sorted(r.name for r in problem.robots)
         places = {job.location for job in problem.jobs}
         legs = {(r, place): least_leg_into(problem, r, place) for r in robots
@@ -112,7 +113,7 @@ class _LoadModel:
         values = [d for found in choices.values() for d, _ in found]
         values += [r.release_time for r in problem.robots] + list(legs.values())
         values += list(entries.values())
-        self.scale = scale = min(MAX_GRID, math.lcm(*(v.denominator for v in values)))
+        self.scale = min(MAX_GRID, math.lcm(*(v.denominator for v in values)))
         ticks = self.ticks
         # Room for the longest route (a longest least way into each place) or chain of ways
         # (one into each job).
@@ -123,9 +124,9 @@ class _LoadModel:
         horizon = sum(max(ticks(d) for d, _ in found) for found in choices.values())
         horizon += max(ticks(r.release_time) for r in problem.robots) + max(
             map(ticks, entries.values()), default=0) + sum(map(ticks, legs.values()))
-        horizon += (len(problem.jobs) if chains else len(places)) * longest_way
+        horizon += (len(places) if before is None else len(problem.jobs)) * longest_way
         self.model = m = cp_model.CpModel()
-        makespan = m.new_int_var(0, horizon, 'makespan')
+        self.makespan = makespan = m.new_int_var(0, horizon, 'makespan')
         load = {r: [] for r in robots}
         works = {}
         """(robot, place) -> the literals of the choices that have the robot work there."""
@@ -140,7 +141,6 @@ class _LoadModel:
                     load[r].append(pick * ticks(duration))
                     works.setdefault((r, job.location), []).append(pick)
                     picked.setdefault((r, job.name), []).append(pick)
-        before = problem.ancestors() if chains else None
         for robot in problem.robots:
             r = robot.name
             visits, firsts, travel = [], [], []
@@ -172,12 +172,14 @@ class _LoadModel:
             if routes:
                 m.add(makespan >= busy + _route_through(m, problem, robot, ticks, places_of,
                                                         visits))
-            if chains:
+            if before is not None:
                 m.add(makespan >= busy + _chained_ways(m, problem, robot, ticks, picked,
                                                        before, horizon))
-        if floor is not None:
-            m.add(makespan >= -(-floor.numerator * scale // floor.denominator))
         m.minimize(makespan)
+
+    def raise_floor(self, floor: Fraction):
+        """The makespan no less than `floor` (a bound proven already) from now on."""
+        self.model.add(self.makespan >= -(-floor.numerator * self.scale // floor.denominator))
 
     def ticks(self, value: Fraction) -> int:
         return value.numerator * self.scale // value.denominator
@@ -204,12 +206,9 @@ class _LoadModel:
                 status == 'OPTIMAL')
 
 
-def _places_chained(problem: Problem) -> bool:
-    """Whether travel takes time and some job precedes another at another place: else no
-    chain adds a way."""
-    if problem.locomote is None:
-        return False
-    before = problem.ancestors()
+def _places_chained(problem: Problem, before) -> bool:
+    """Whether some job precedes another at another place (`before`: job -> its
+    ancestors): else no chain adds a way."""
     return any(problem.job(a).location != job.location
                for job in problem.jobs for a in before[job.name])
 
@@ -233,14 +232,14 @@ def _chained_ways(m, problem: Problem, robot, ticks, picked, before, horizon):
             m.add(up_to[name] >= entry).only_enforce_if(does[name])
         m.add(longest >= up_to[name])
     for job in mine:
-        for earlier in mine:
+        for earlier in sorted(before[job.name] & does.keys()):
             # Ways between jobs at one place are 0; a chain through such a pair is also a
             # pair of jobs at two places, as ancestors are transitive.
-            if earlier.name in before[job.name] and earlier.location != job.location:
-                way = ticks(least_location_travel(problem, r, earlier.location,
-                                                  job.location))
-                m.add(up_to[job.name] >= up_to[earlier.name] + way).only_enforce_if(
-                    [does[earlier.name], does[job.name]])
+            place = problem.job(earlier).location
+            if place != job.location:
+                way = ticks(least_location_travel(problem, r, place, job.location))
+                m.add(up_to[job.name] >= up_to[earlier] + way).only_enforce_if(
+                    [does[earlier], does[job.name]])
     return longest
 
 
