@@ -35,7 +35,7 @@ def test_the_search_past_the_routing_size_shortens_its_start():
     holding arcs, as if past the size): valid, and shorter than one greedy pass."""
     problem = parse_scenario(random_scenario(5, Shape(jobs=40, robots=6)))
     greedy = greedy_schedule(problem)
-    result = solve_large(problem, Start(greedy, None), time.monotonic(), 2)
+    result = solve_large(problem, Start(greedy, None), time.monotonic(), 2, workers=2)
     assert validate(problem, result.schedule) == []
     assert result.makespan < greedy.makespan
     assert result.lower_bound <= result.makespan

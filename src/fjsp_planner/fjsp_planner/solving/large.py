@@ -1,6 +1,7 @@
 """Problems too large for the CP-SAT routing model: the greedy schedule, then the local
-search from it for the rest of the limit, or randomised greedy passes when no greedy schedule
-came in time (docs/solver.md, "Large problems").
+search from it for the rest of the limit (two runs, a core each, given two cores), or
+randomised greedy passes when no greedy schedule came in time (docs/solver.md, "Large
+problems").
 
 The CP-SAT model has one routing arc per robot and ordered pair of jobs it could do: past
 `CPSAT_ROUTING_ARCS` building it alone takes longer than a usual limit and its memory grows
@@ -16,7 +17,7 @@ from fjsp_planner.model.problem import Problem
 from fjsp_planner.model.schedule import Result, Status
 from fjsp_planner.solving.bounds.fleet import static_bound
 from fjsp_planner.solving.greedy import sampled_schedule
-from fjsp_planner.solving.local import local_search
+from fjsp_planner.solving.local_process import local_searches
 from fjsp_planner.solving.start import Start
 
 CPSAT_ROUTING_ARCS = 400_000
@@ -42,15 +43,16 @@ def fits_cpsat(problem: Problem) -> bool:
 
 
 def solve_large(problem: Problem, start: Start, began: float, time_limit: float,
-                seed: int = 0) -> Result:
-    """The local search from the start until the limit (without a start, the best of
-    randomised greedy passes), with the static bound (`bounds.fleet.static_bound`)."""
+                workers: int, seed: int = 0) -> Result:
+    """The local search from the start until the limit, two runs of it with two or more
+    `workers` (without a start, the best of randomised greedy passes), with the static bound
+    (`bounds.fleet.static_bound`)."""
     deadline = began + time_limit
-    best, solver = start.best, 'greedy'
+    best, solver, notes = start.best, 'greedy', ()
     if best is not None:
         first_at = best_at = time.monotonic() - began
         how = 'the local search from the greedy schedule'
-        found, found_at = local_search(problem, best, deadline, seed=seed)
+        found, found_at, notes = local_searches(problem, best, deadline, min(2, workers))
         if found is not best:
             best, best_at, solver = found, found_at - began, 'local search'
     else:
@@ -65,6 +67,6 @@ def solve_large(problem: Problem, start: Start, began: float, time_limit: float,
     return Result(Status.OPTIMAL if bound >= best.makespan else Status.FEASIBLE,
                   best.makespan, bound, elapsed, best, solver,
                   first_solution_seconds=first_at, best_solution_seconds=best_at,
-                  notes=start.notes + (f'{routing_arcs(problem)} routing arcs are more than '
-                                       f'the CP-SAT model takes ({CPSAT_ROUTING_ARCS}); '
-                                       f'{how}',))
+                  notes=start.notes + notes + (
+                      f'{routing_arcs(problem)} routing arcs are more than the CP-SAT model '
+                      f'takes ({CPSAT_ROUTING_ARCS}); {how}',))

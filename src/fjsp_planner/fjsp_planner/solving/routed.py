@@ -1,16 +1,16 @@
-"""Multi-robot jobs with travel, beyond the sizes CP-SAT proves at once: CP-SAT and the local
-search side by side, from the start (docs/solver.md, "Local search").
+"""Multi-robot jobs with travel, beyond the sizes CP-SAT proves at once: CP-SAT or the local
+search, from the start (docs/solver.md, "Local search").
 
-CP-SAT runs in a thread of its own from the start's schedule, for its bound and its own
-improvements (up to MAX_PAIRWISE_JOBS jobs without its linear relaxation and with the travel
-between every two jobs of a robot, which prove such scenarios sooner, and with every core:
-its schedules win there, and the local search would only take time from its proofs; beyond,
-with one worker fewer, since the search then finds the schedules and needs a core); the local
-search (`local`) runs meanwhile from the same schedule beyond MAX_PAIRWISE_JOBS, and the
-fleet load, operation set and chain bounds (`bounds.assignment`, `bounds.operations`,
-`bounds.chains`) one after the other in a thread of their own, each briefly (the first for a
-fixed amount of CP-SAT's work, the others for a share of the limit). The shorter schedule
-wins; the bound is the best of CP-SAT's, the static bound and those three.
+Up to MAX_PAIRWISE_JOBS jobs CP-SAT runs with every core, in a thread of its own, from the
+start's schedule, without its linear relaxation and with the travel between every two jobs
+of a robot, which prove such scenarios sooner: its schedules win there. Beyond, the local
+search (`local`) finds the schedules: two runs of it from the start, the second in a process
+of its own (`local_process`), get a core each, and CP-SAT whatever cores are left, if any.
+Meanwhile the fleet load, operation set and chain bounds (`bounds.assignment`,
+`bounds.operations`, `bounds.chains`) run one after the other in a thread of their own, each
+briefly (the first for a fixed amount of CP-SAT's work, the others for a share of the
+limit). The shortest schedule wins; the bound is the best of CP-SAT's, the static bound and
+those three.
 """
 
 import time
@@ -23,7 +23,7 @@ from fjsp_planner.solving.bounds.assignment import fleet_load_bound
 from fjsp_planner.solving.bounds.chains import chain_bound
 from fjsp_planner.solving.bounds.fleet import static_bound
 from fjsp_planner.solving.bounds.operations import operation_bound
-from fjsp_planner.solving.local import local_search
+from fjsp_planner.solving.local_process import local_searches
 from fjsp_planner.solving.start import Start
 
 MIN_JOBS = 25
@@ -79,28 +79,38 @@ def solve_routed(problem: Problem, start: Start, began: float, time_limit: float
     first = start.best
     setup = time.monotonic() - began
     small = len(problem.jobs) <= MAX_PAIRWISE_JOBS
-    # Above MAX_PAIRWISE_JOBS the local search finds the schedules: it gets a core of its own.
-    search = CpsatBeside(problem, deadline, workers if small else max(1, workers - 1), first,
-                         start.hint or first, log,
-                         relaxation=not small, pairwise_travel=small)
+    # Above MAX_PAIRWISE_JOBS the local search finds the schedules: two runs of it get a core
+    # each, CP-SAT whatever cores are left.
+    searches = 1 if small else min(2, workers)
+    search = (CpsatBeside(problem, deadline, workers if small else workers - searches, first,
+                          start.hint or first, log, relaxation=not small,
+                          pairwise_travel=small)
+              if small or workers > searches else None)
     load = Beside('fleet load and chain bounds', lambda: search_free_bound(
         problem, time_limit, first.makespan))
     if small:
-        best, best_at = first, time.monotonic()
+        best, best_at, notes = first, time.monotonic(), ()
     else:
-        best, best_at = local_search(problem, first, deadline, stop=search.done)
+        best, best_at, notes = local_searches(problem, first, deadline, searches,
+                                              stop=None if search is None else search.done)
     solver = 'local search' if best is not first else 'greedy'
-    result = search.result()
-    # The first schedule is valid: CP-SAT claiming infeasibility was given a bound too high.
-    disproved = (('CP-SAT claimed the problem infeasible, which the first schedule disproves',)
-             if result.status == Status.INFEASIBLE else ())
-    if result.schedule is not None and result.makespan < best.makespan:
-        best, solver = result.schedule, 'cpsat'
-        best_at = search.started + (result.best_solution_seconds or result.solve_seconds)
-    bound = min(max(result.lower_bound or 0, static_bound(problem), load.result() or 0),
-                best.makespan)
+    notes = start.notes + notes
+    bound = max(static_bound(problem), load.result() or 0)
+    if search is not None:
+        result = search.result()
+        notes += result.notes
+        # The first schedule is valid: CP-SAT claiming infeasibility was given a bound too
+        # high.
+        if result.status == Status.INFEASIBLE:
+            notes += ('CP-SAT claimed the problem infeasible, which the first schedule '
+                      'disproves',)
+        if result.schedule is not None and result.makespan < best.makespan:
+            best, solver = result.schedule, 'cpsat'
+            best_at = search.started + (result.best_solution_seconds or result.solve_seconds)
+        bound = max(bound, result.lower_bound or 0)
+    bound = min(bound, best.makespan)
     return Result(Status.OPTIMAL if bound >= best.makespan else Status.FEASIBLE,
                   best.makespan, bound, time.monotonic() - began, best, solver,
                   first_solution_seconds=setup, best_solution_seconds=max(best_at - began,
                                                                           setup),
-                  notes=start.notes + result.notes + disproved)
+                  notes=notes)

@@ -78,7 +78,7 @@ def _backend(problem, solver, start, began, time_limit, workers, keep, mip_backe
         return portfolio.with_panel_bounds(problem, result, None) if portfolio.applies(
             problem) else result
     if not large.fits_cpsat(problem):
-        result = large.solve_large(problem, start, began, time_limit)
+        result = large.solve_large(problem, start, began, time_limit, workers)
         return portfolio.with_panel_bounds(problem, result, None) if portfolio.applies(
             problem) else result
     if start.hint is None and keep is None and start.greedy is not None and tabu.applies(
