@@ -1,6 +1,7 @@
 """The local search in a process of its own: its schedule comes back valid, and a child
 that fails leaves the first run's schedule and a note saying why, never an error."""
 
+import subprocess
 import sys
 import time
 
@@ -77,3 +78,34 @@ def test_a_child_past_its_deadline_is_killed(tmp_path, monkeypatch):
     assert process.result() is None
     assert 'within 0.5 s' in process.failure
     assert time.monotonic() - began < 10
+
+
+def test_a_child_stops_when_its_parent_ends():
+    """A parent killed mid-search leaves no search running to its deadline."""
+    parent = subprocess.run([sys.executable, '-c', (
+        'import os, sys, time\n'
+        f'sys.path[:0] = {sys.path!r}\n'
+        'from fjsp_planner.model.generator import Shape, random_scenario\n'
+        'from fjsp_planner.model.scenario import parse_scenario\n'
+        'from fjsp_planner.solving.greedy import greedy_schedule\n'
+        'from fjsp_planner.solving.local_process import LocalSearchProcess\n'
+        'problem = parse_scenario(random_scenario(5, Shape(jobs=40, robots=6)))\n'
+        'process = LocalSearchProcess(problem, greedy_schedule(problem),\n'
+        '                             time.monotonic() + 120, seed=1)\n'
+        'time.sleep(1)\n'
+        'print(process._child.pid, flush=True)\n'
+        'os._exit(0)\n')], capture_output=True, text=True, timeout=60, check=True)
+    child = int(parent.stdout.split()[-1])
+    waited = time.monotonic()
+    while _running(child) and time.monotonic() - waited < 20:
+        time.sleep(0.1)
+    assert not _running(child)
+
+
+def _running(pid: int) -> bool:
+    """Whether the process runs (a zombie, ended but not yet reaped by init, does not)."""
+    try:
+        with open(f'/proc/{pid}/stat') as stat:
+            return stat.read().rsplit(')', 1)[1].split()[0] != 'Z'
+    except FileNotFoundError:
+        return False

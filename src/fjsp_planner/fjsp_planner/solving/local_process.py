@@ -7,7 +7,7 @@ the problem, the start, the deadline (`time.monotonic()`, one clock for every pr
 machine) and the seed as a pickle on its standard input, and writes the schedule it found and
 when as a pickle on its standard output. Its schedule crosses a pipe, so the parent validates
 it again; a child that fails, or overruns its deadline by more than `GRACE` seconds, is
-killed and leaves a note instead of a schedule.
+killed and leaves a note instead of a schedule. A child whose parent has ended stops at once.
 """
 
 import os
@@ -109,8 +109,11 @@ class LocalSearchProcess:
 
 
 def _serve():
+    parent = os.getppid()
     problem, start, deadline, seed = pickle.load(sys.stdin.buffer)
-    found = local_search(problem, start, deadline, seed=seed)
+    # A parent killed meanwhile would leave the search running to its deadline.
+    found = local_search(problem, start, deadline, seed=seed,
+                         stop=lambda: os.getppid() != parent)
     sys.stdout.buffer.write(pickle.dumps(found))
 
 
