@@ -5,8 +5,10 @@
 - `start`: what every backend starts from and falls back on (greedy schedule, hint);
 - `portfolio`: several identical panels: CP-SAT beside the panel bounds;
 - `classic`: the classic flexible job shop: CP-SAT beside the tabu search;
-- `routed`: multi-robot jobs with travel: CP-SAT beside the local search (`local`);
-- `large`: problems too large for the CP-SAT routing model: randomised greedy passes;
+- `routed`: multi-robot jobs with travel: CP-SAT up to 40 jobs, beyond two runs of the local
+  search (`local`), the second in a process of its own (`local_process`);
+- `large`: problems too large for the CP-SAT routing model: the local search as beyond 40
+  routed jobs;
 - `compact`: left-shifting a schedule (every job as early as its robots allow);
 - `beside`: work run in threads beside the main search;
 - `cpsat/`: the CP-SAT model and search, split by concern;

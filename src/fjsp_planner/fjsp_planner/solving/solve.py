@@ -35,8 +35,8 @@ def solve(problem: Problem, solver: str = 'cpsat', time_limit: float = 10.0, wor
     Every schedule returned is left-shifted (`compact`). The backends: `greedy` alone;
     `mip`, the paper's program; `cpsat`, the CP-SAT model, beside the tabu search on the
     classic flexible job shop (`classic`), with the panel bounds on several identical
-    panels (`portfolio`), beside the local search on other routed problems (`routed`), and
-    randomised greedy passes where the CP-SAT routing model would be too large (`large`).
+    panels (`portfolio`), or the local search on other routed problems (`routed`), and the
+    local search where the CP-SAT routing model would be too large (`large`).
 
     Plans no robot of the problem can staff are left out first (`staffable`); the schedule
     names plans as `problem` does. The whole call (greedy, model building, solving, keeping
