@@ -5,12 +5,17 @@ import subprocess
 import sys
 import time
 
+import pytest
+
 from fjsp_planner.model.generator import Shape, random_scenario
 from fjsp_planner.model.scenario import parse_scenario
 from fjsp_planner.model.validate import validate
 from fjsp_planner.solving import local_process
 from fjsp_planner.solving.greedy import greedy_schedule
 from fjsp_planner.solving.local_process import LocalSearchProcess, local_searches
+
+# Each waits for a search of one to a few seconds in a child process.
+pytestmark = pytest.mark.slow
 
 
 def scenario():
