@@ -114,3 +114,13 @@ def _running(pid: int) -> bool:
             return stat.read().rsplit(')', 1)[1].split()[0] != 'Z'
     except FileNotFoundError:
         return False
+
+
+def test_a_problem_that_cannot_be_sent_leaves_a_note(monkeypatch):
+    def refuse(*args):
+        raise TypeError('cannot pickle this')
+    monkeypatch.setattr(local_process.pickle, 'dump', refuse)
+    problem, greedy = scenario()
+    best, _, notes = local_searches(problem, greedy, time.monotonic() + 2.5, runs=2)
+    assert validate(problem, best) == []
+    assert notes == ('the local search in a second process could not start: cannot pickle this',)

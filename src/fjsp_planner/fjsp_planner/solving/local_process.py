@@ -7,7 +7,8 @@ the problem, the start, the deadline (`time.monotonic()`, one clock for every pr
 machine) and the seed as a pickle on its standard input, and writes the schedule it found and
 when as a pickle on its standard output. Its schedule crosses a pipe, so the parent validates
 it again; a child that fails, or overruns its deadline by more than `GRACE` seconds, is
-killed and leaves a note instead of a schedule. A child whose parent has ended stops at once.
+killed and leaves a note instead of a schedule. A child whose parent has ended stops at its
+next step.
 """
 
 import os
@@ -68,7 +69,7 @@ class LocalSearchProcess:
                     [sys.executable, '-m', __name__], stdin=request,
                     stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                     env=dict(os.environ, PYTHONPATH=path))
-        except OSError as error:
+        except Exception as error:  # no process to start, or a problem pickle refuses
             self._child, self.failure = None, f'could not start: {error}'
 
     def result(self) -> tuple[Schedule, float] | None:
