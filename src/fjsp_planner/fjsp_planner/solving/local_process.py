@@ -103,9 +103,10 @@ class LocalSearchProcess:
         return schedule, found_at
 
     def stop(self):
-        """End the child now, its schedule unread."""
-        if self._child is not None and self._child.poll() is None:
-            self._child.kill()
+        """End the child now, its schedule unread (its pipes closed even if it had ended)."""
+        if self._child is not None:
+            if self._child.poll() is None:
+                self._child.kill()
             self._child.communicate()
 
 
